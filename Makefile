@@ -1,0 +1,89 @@
+# vrlib: every result, the report and the tests from one Makefile.
+#   make all      set up .venv (first use), regenerate every chapter result, build the report
+#   make test     set up .venv (first use), run the test suite (MPI tests included)
+# The chapter scripts are tracked like any build rule: a script re-runs only when it, the
+# library, or the results it reads have changed.
+
+SHELL := /bin/bash
+.SHELLFLAGS := -eu -o pipefail -c
+.DEFAULT_GOAL := all
+.DELETE_ON_ERROR:
+.SECONDEXPANSION:
+
+PYTHON ?= $(shell command -v python3.11 || command -v python3)
+VENV := .venv
+PY := $(VENV)/bin/python
+INSTALLED := $(VENV)/.installed
+
+# Sizes of the chapter experiments: default (minutes on 2 cores) or full (thesis scale).
+PROFILE ?= default
+export VRLIB_PROFILE := $(PROFILE)
+export NUMBA_CACHE_DIR := $(CURDIR)/build/numba
+# numba's default OpenMP layer kills a child forked after a parallel call; workqueue does not.
+export NUMBA_THREADING_LAYER := workqueue
+export MPLBACKEND := Agg
+export VTK_DEFAULT_OPENGL_WINDOW := vtkEGLRenderWindow
+export PYTHONHASHSEED := 0
+
+LIBRARY := $(shell find vrlib data_gen -name '*.py' -not -path '*/__pycache__/*')
+CHAPTER_COMMON := $(wildcard chapters/*.py)
+RUNS := $(wildcard chapters/*/run_*.py)
+PLOTS := $(wildcard chapters/*/fig_*.py chapters/*/tab_*.py)
+stamp = $(patsubst chapters/%.py,build/stamps/%.done,$(1))
+RESULTS := $(call stamp,$(RUNS) $(PLOTS))
+DOCS := $(shell find docs -type f -not -path 'docs/_build/*')
+REPORT := build/report/html/index.html
+
+.PHONY: all venv results report test test-all bench clean distclean
+
+all: results report
+
+venv: $(INSTALLED)
+
+$(INSTALLED): pyproject.toml constraints.txt
+	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
+	$(PY) -m pip install --quiet --disable-pip-version-check -c constraints.txt -e '.[all]'
+	@touch $@
+
+results: $(RESULTS)
+
+# run_* scripts compute and write build/results/<chapter>/...
+build/stamps/%.done: chapters/%.py $(LIBRARY) $(CHAPTER_COMMON) $(INSTALLED)
+	@mkdir -p $(@D)
+	@echo "[chapters] $*"
+	$(PY) chapters/$*.py
+	@touch $@
+
+# fig_* and tab_* scripts also read what the run_* scripts of their chapter wrote.
+$(call stamp,$(PLOTS)): build/stamps/%.done: \
+		$$(call stamp,$$(wildcard chapters/$$(dir $$*)run_*.py))
+
+report: $(REPORT)
+
+# Built into a fresh folder and swapped in whole: never a half-written report.
+$(REPORT): $(DOCS) $(RESULTS) $(LIBRARY) $(INSTALLED)
+	@rm -rf build/report/html.tmp
+	$(PY) -m sphinx -W --keep-going -q -b html -d build/report/doctrees docs build/report/html.tmp
+	@rm -rf build/report/html && mv build/report/html.tmp build/report/html
+	@echo "report: $(REPORT)"
+
+test: $(INSTALLED)
+	$(PY) -m pytest -m "not slow"
+
+# Everything, slow checks included, then the whole suite again with the JIT off so the numba
+# kernels run as plain Python.
+test-all: $(INSTALLED)
+	$(PY) -m pytest
+	NUMBA_DISABLE_JIT=1 $(PY) -m pytest -m "not slow" tests
+
+bench: $(INSTALLED)
+	$(PY) -m pytest benchmarks --benchmark-enable --benchmark-only --benchmark-columns=min,median,max,rounds
+	@for script in benchmarks/bench_*.py; do [ -e "$$script" ] || continue; \
+		echo "== $$script"; $(PY) "$$script"; done
+
+clean:
+	rm -rf build figures docs/_build
+	find . -name __pycache__ -type d -not -path './.venv/*' -prune -exec rm -rf {} +
+
+distclean: clean
+	rm -rf $(VENV)

@@ -1,0 +1,106 @@
+"""Transfer functions: Glow, lookup tables, shading, and their kernel twins."""
+
+import numpy as np
+import pytest
+
+from vrlib import Glow, LookupTransfer, Phong
+from vrlib._kernels import transfer as kernels
+
+
+def kernel_density(tf, values):
+    kind, scale, lo, hi, dtab, _ = tf.code
+    return np.array([kernels.density(kind, scale, lo, hi, dtab, v) for v in values])
+
+
+def kernel_emission(tf, values):
+    kind, _, lo, hi, _, ctab = tf.code
+    return np.array([[kernels.emission(kind, lo, hi, ctab, v, c) for c in range(3)]
+                     for v in values])
+
+
+VALUES = np.linspace(-0.5, 2.5, 61)
+
+
+def test_glow_is_the_study_function():
+    """Eq 1.9 with O the identity (scaled) and S = 1."""
+    glow = Glow(3.0)
+    np.testing.assert_allclose(glow.opacity_density(VALUES), 3.0 * np.maximum(VALUES, 0))
+    np.testing.assert_array_equal(glow.emission(VALUES), np.ones((61, 3)))
+    assert glow.max_density(-2.0, -1.0) == 0.0
+    assert glow.max_density(-1.0, 0.5) == 1.5
+
+
+def make_table():
+    rng = np.random.default_rng(3)
+    return LookupTransfer(rng.uniform(0, 5, 9), rng.uniform(0, 1, (9, 3)),
+                          value_range=(0.0, 2.0))
+
+
+@pytest.mark.parametrize("tf", [Glow(2.0), make_table()], ids=["glow", "table"])
+def test_kernels_match_numpy(tf):
+    np.testing.assert_allclose(kernel_density(tf, VALUES), tf.opacity_density(VALUES),
+                               atol=1e-13)
+    np.testing.assert_allclose(kernel_emission(tf, VALUES), tf.emission(VALUES), atol=1e-13)
+
+
+def test_table_interpolates_and_clamps():
+    tf = LookupTransfer([0.0, 2.0, 1.0], [[0, 0, 0], [1, 0, 0], [0, 0, 1]],
+                        value_range=(1.0, 3.0))
+    np.testing.assert_allclose(tf.opacity_density([0.0, 1.5, 2.0, 2.5, 9.0]),
+                               [0.0, 1.0, 2.0, 1.5, 1.0])
+    np.testing.assert_allclose(tf.emission([2.5]), [[0.5, 0, 0.5]])
+
+
+def test_table_max_density_bounds_every_value_in_range():
+    tf = make_table()
+    rng = np.random.default_rng(0)
+    for _ in range(200):
+        lo, hi = np.sort(rng.uniform(-1, 3, 2))
+        inside = np.linspace(lo, hi, 501)
+        bound = tf.max_density(lo, hi)
+        assert bound >= tf.opacity_density(inside).max() - 1e-12
+        assert bound == pytest.approx(tf.opacity_density(inside).max(), abs=0.05)
+
+
+def test_from_alpha_matches_vtk_opacity_units():
+    """VTK's scalar opacity is alpha per unit distance; density -ln(1 - a)/d reproduces it."""
+    tf = LookupTransfer.from_alpha([0.0, 0.5], unit_distance=0.25)
+    alpha_over_unit = 1 - np.exp(-tf.opacity_density([1.0]) * 0.25)
+    np.testing.assert_allclose(alpha_over_unit, [0.5])
+
+
+def test_phong_factor():
+    shade = Phong(ambient=0.2, diffuse=0.6, specular=0.5, shininess=4.0)
+    view_dir = np.array([0.0, 0.0, 1.0])
+    grads = np.array([[0.0, 0.0, -1.0], [1.0, 0.0, 0.0], [0.0, 0.0, 0.0], [0.0, 0.0, 3.0]])
+    np.testing.assert_allclose(shade.factor(grads, view_dir), [0.8, 0.2, 0.8, 0.8])
+    np.testing.assert_allclose(shade.highlight(grads, view_dir), [0.5, 0.0, 0.5, 0.5])
+    lit_side = Phong(ambient=0.0, diffuse=1.0, light=(1, 0, 0))
+    np.testing.assert_allclose(lit_side.factor(grads, view_dir), [0.0, 1.0, 1.0, 0.0])
+
+
+@pytest.mark.parametrize(
+    "call, error, message",
+    [
+        (lambda: Glow(0.0), ValueError, "scale must be > 0"),
+        (lambda: Glow(np.nan), ValueError, "scale must be finite"),
+        (lambda: Glow(1.0, shading="phong"), TypeError, "shading must be a vrlib.Phong"),
+        (lambda: LookupTransfer([1.0]), ValueError, "at least 2 entries"),
+        (lambda: LookupTransfer([[1.0, 2.0]]), ValueError, "density must be 1-dimensional"),
+        (lambda: LookupTransfer([1.0, -1.0]), ValueError, "must be >= 0"),
+        (lambda: LookupTransfer([1.0, np.nan]), ValueError, "only finite values"),
+        (lambda: LookupTransfer([1.0, 2.0], [[1, 1, 1]]), ValueError,
+         r"color table must have shape \(2, 3\)"),
+        (lambda: LookupTransfer([1.0, 2.0], [[1, 1], [1, 1]]), ValueError,
+         r"shape \(2, 3\) to match"),
+        (lambda: LookupTransfer([1.0, 2.0], value_range=(1.0, 1.0)), ValueError,
+         "value_range must be increasing"),
+        (lambda: LookupTransfer.from_alpha([0.0, 1.0]), ValueError, r"alpha entries .* \[0, 1\)"),
+        (lambda: Phong(ambient=-0.1), ValueError, "ambient must be >= 0"),
+        (lambda: Phong(shininess=0.0), ValueError, "shininess must be > 0"),
+        (lambda: Phong(light=(0, 0, 0)), ValueError, "light must be a non-zero vector"),
+    ],
+)
+def test_bad_input(call, error, message):
+    with pytest.raises(error, match=message):
+        call()

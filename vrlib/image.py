@@ -1,0 +1,134 @@
+"""Rendered images: premultiplied RGBA plus what the render cost."""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+
+from vrlib import _validate
+from vrlib._io import atomic_path
+from vrlib._png import encode_png
+
+__all__ = ["Image", "RenderStats"]
+
+
+@dataclass
+class RenderStats:
+    """What a render did: work counters and wall time.
+
+    Attributes
+    ----------
+    samples : int
+        Reconstructed points (ray samples, splatted voxels, resampled voxels...).
+    operations : int
+        Arithmetic operations by the renderer's own count model.
+    bytes : int
+        Bytes of the largest buffers the renderer held.
+    seconds : float
+        Wall time of the render.
+    """
+
+    samples: int = 0
+    operations: int = 0
+    bytes: int = 0
+    seconds: float = 0.0
+
+    def as_dict(self):
+        """The counters as a plain dict."""
+        return asdict(self)
+
+
+class Image:
+    """A rendered image: premultiplied RGBA, float64, row 0 at the top.
+
+    Parameters
+    ----------
+    rgba : array_like, shape (height, width, 4)
+        Premultiplied colour and opacity, finite; alpha in [0, 1].
+    stats : RenderStats, optional
+
+    Examples
+    --------
+    >>> img = Image(np.full((2, 3, 4), 0.5))
+    >>> img.shape, img.alpha.tolist()[0]
+    ((2, 3), [0.5, 0.5, 0.5])
+    >>> img.straight_rgb()[0, 0].tolist()
+    [1.0, 1.0, 1.0]
+    """
+
+    def __init__(self, rgba, stats=None):
+        arr = _validate.finite_array("rgba", rgba, ndim=3)
+        if arr.shape[2] != 4:
+            raise ValueError(f"rgba must have shape (height, width, 4), got {arr.shape}")
+        alpha = arr[..., 3]
+        if np.any((alpha < 0.0) | (alpha > 1.0 + 1e-9)):
+            raise ValueError("rgba alpha must lie in [0, 1]")
+        self.rgba = arr
+        self.stats = RenderStats() if stats is None else stats
+
+    @property
+    def alpha(self):
+        """Opacity per pixel, ``(height, width)``."""
+        return self.rgba[..., 3]
+
+    @property
+    def shape(self):
+        """``(height, width)``."""
+        return self.rgba.shape[:2]
+
+    def straight_rgb(self):
+        """Un-premultiplied colour (zero where alpha is zero)."""
+        a = self.alpha[..., None]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            return np.where(a > 0.0, self.rgba[..., :3] / a, 0.0)
+
+    def composited(self, background=(0.0, 0.0, 0.0)):
+        """RGB over an opaque ``background`` colour."""
+        bg = _validate.vector3("background", background)
+        return self.rgba[..., :3] + (1.0 - self.rgba[..., 3:4]) * bg
+
+    def save(self, path, *, bits=8, background=(0.0, 0.0, 0.0)):
+        """Write the image to ``.png`` or ``.npy``, atomically (temporary name, then rename).
+
+        Parameters
+        ----------
+        path : str or Path
+            ``.png``: 8- or 16-bit; ``.npy``: the float64 premultiplied RGBA array.
+        bits : {8, 16}
+            PNG bit depth.
+        background : 3 floats or None
+            PNG only: composite over this colour and write RGB; ``None`` writes RGBA with
+            straight (un-premultiplied) alpha, as PNG defines it.
+
+        Examples
+        --------
+        >>> import tempfile, pathlib
+        >>> out = pathlib.Path(tempfile.mkdtemp()) / "img.png"
+        >>> Image(np.full((2, 2, 4), 0.25)).save(out, bits=16)
+        >>> out.read_bytes()[:4]
+        b'\\x89PNG'
+        """
+        path = Path(path)
+        suffix = path.suffix.lower()
+        if suffix not in (".png", ".npy"):
+            raise ValueError(f"path must end in .png or .npy, got {path.name!r}")
+        if suffix == ".npy":
+            with atomic_path(path) as tmp:
+                np.save(tmp, self.rgba)
+            return
+        if bits not in (8, 16):
+            raise ValueError(f"bits must be 8 or 16, got {bits!r}")
+        if background is None:
+            pixels = np.concatenate([self.straight_rgb(), self.rgba[..., 3:4]], axis=-1)
+        else:
+            pixels = self.composited(background)
+        top = (1 << bits) - 1
+        dtype = np.uint8 if bits == 8 else np.uint16
+        quantised = np.round(np.clip(pixels, 0.0, 1.0) * top).astype(dtype)
+        with atomic_path(path) as tmp:
+            tmp.write_bytes(encode_png(quantised))
+
+    def __repr__(self):
+        return f"Image(shape={self.shape}, max_alpha={float(self.alpha.max(initial=0.0)):.4g})"

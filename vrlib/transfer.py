@@ -1,0 +1,255 @@
+"""Transfer functions: from a reconstructed value to opacity density and emitted colour.
+
+The rendering model (eqs 1.2-1.5) needs, at every point, a differential opacity
+``Omega = O(F)`` (per world unit) and an emission ``E = S(F)``. With ``1/Omega`` folded into
+``S`` a segment of opacity ``alpha`` contributes ``E * alpha`` of premultiplied colour (eq 1.9).
+
+* :class:`Glow` is the thesis's study function: ``O`` the identity (times a scale), ``S = 1``:
+  "the data glows in proportion to its value", so every image error comes from reconstruction.
+* :class:`LookupTransfer` tabulates density and colour for general use.
+* :class:`Phong` adds gradient shading to either.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from vrlib import _validate
+from vrlib._kernels import transfer as _k
+
+__all__ = ["TransferFunction", "Glow", "LookupTransfer", "Phong"]
+
+
+class Phong:
+    """Gradient (Phong-style) shading of the emitted colour.
+
+    A sample with unit normal ``n = -grad F / |grad F|`` lit from direction ``l`` (towards the
+    light) and seen from direction ``v`` (towards the eye) emits
+    ``E * (ambient + diffuse * |n.l|) + specular * |n.h|^shininess`` with ``h`` the unit
+    half-vector of ``l`` and ``v`` (two-sided lighting). Where the gradient vanishes the sample
+    has no normal and is shaded as if facing the light.
+
+    Parameters
+    ----------
+    ambient, diffuse, specular : float
+        Non-negative coefficients.
+    shininess : float
+        Specular exponent (> 0).
+    light : array_like of 3 floats, optional
+        World direction towards the light; ``None`` (default) is a headlight along the view.
+
+    Examples
+    --------
+    >>> shade = Phong(ambient=0.2, diffuse=0.8, specular=0.0)
+    >>> shade.factor(np.array([[0.0, 0.0, -2.0]]), view_dir=[0, 0, 1]).tolist()
+    [1.0]
+    """
+
+    def __init__(self, *, ambient=0.3, diffuse=0.7, specular=0.0, shininess=20.0, light=None):
+        self.ambient = _validate.finite_number("ambient", ambient, low=0.0)
+        self.diffuse = _validate.finite_number("diffuse", diffuse, low=0.0)
+        self.specular = _validate.finite_number("specular", specular, low=0.0)
+        self.shininess = _validate.positive_number("shininess", shininess)
+        self.light = None if light is None else _validate.vector3("light", light, unit=True)
+
+    def factor(self, gradient, view_dir):
+        """Multiplier of the emission for gradients ``(..., 3)`` seen from ``view_dir``."""
+        v = _validate.vector3("view_dir", view_dir, unit=True)
+        light = v if self.light is None else self.light
+        g = np.asarray(gradient, dtype=np.float64)
+        norm = np.linalg.norm(g, axis=-1)
+        safe = np.where(norm > 0.0, norm, 1.0)[..., None]
+        n = -g / safe
+        ndotl = np.where(norm > 0.0, np.abs(n @ light), 1.0)
+        return self.ambient + self.diffuse * ndotl
+
+    def highlight(self, gradient, view_dir):
+        """Specular term (added to every colour channel) for gradients ``(..., 3)``."""
+        v = _validate.vector3("view_dir", view_dir, unit=True)
+        light = v if self.light is None else self.light
+        half = light + v
+        half = half / np.linalg.norm(half) if np.any(half) else light
+        g = np.asarray(gradient, dtype=np.float64)
+        norm = np.linalg.norm(g, axis=-1)
+        n = -g / np.where(norm > 0.0, norm, 1.0)[..., None]
+        ndoth = np.where(norm > 0.0, np.abs(n @ half), 1.0)
+        return self.specular * ndoth**self.shininess
+
+    def __repr__(self):
+        light = None if self.light is None else self.light.tolist()
+        return (
+            f"Phong(ambient={self.ambient:g}, diffuse={self.diffuse:g}, "
+            f"specular={self.specular:g}, shininess={self.shininess:g}, light={light})"
+        )
+
+
+class TransferFunction:
+    """Base of the transfer functions: opacity density, emission, optional shading."""
+
+    shading = None
+
+    def opacity_density(self, values):
+        """Opacity density ``Omega`` per world unit (>= 0) at reconstructed ``values``."""
+        raise NotImplementedError
+
+    def emission(self, values):
+        """Emitted colour ``E`` (RGB, last axis) at reconstructed ``values``."""
+        raise NotImplementedError
+
+    def max_density(self, vmin, vmax):
+        """Largest opacity density for any value in ``[vmin, vmax]``: 0 means skippable."""
+        raise NotImplementedError
+
+    @property
+    def code(self):
+        """``(kind, scale, vmin, vmax, density_table, color_table)`` for the numba kernels."""
+        raise NotImplementedError
+
+
+def _check_shading(shading):
+    if shading is not None and not isinstance(shading, Phong):
+        raise TypeError(f"shading must be a vrlib.Phong or None, got {shading!r}")
+    return shading
+
+
+class Glow(TransferFunction):
+    """The thesis's study transfer function: opacity density ``scale * F``, emission 1 (eq 1.9).
+
+    A pixel's value is then its opacity ``1 - exp(-scale * tau)`` with ``tau`` the line
+    integral of the field along its ray, and the image is grey (premultiplied RGB = alpha).
+
+    # Deviation from thesis: negative reconstructed values (a cubic's overshoot) are clamped
+    # to zero density, so that opacity stays in [0, 1].
+
+    Parameters
+    ----------
+    scale : float, default 1.0
+        Opacity density per unit of field value per world unit (> 0).
+    shading : Phong, optional
+        Gradient shading of the (white) emission.
+
+    Examples
+    --------
+    >>> glow = Glow(2.0)
+    >>> glow.opacity_density(np.array([0.5, -1.0])).tolist()
+    [1.0, 0.0]
+    >>> glow.emission(np.array([0.3])).tolist()
+    [[1.0, 1.0, 1.0]]
+    """
+
+    def __init__(self, scale=1.0, *, shading=None):
+        self.scale = _validate.positive_number("scale", scale)
+        self.shading = _check_shading(shading)
+
+    def opacity_density(self, values):
+        return self.scale * np.maximum(np.asarray(values, dtype=np.float64), 0.0)
+
+    def emission(self, values):
+        values = np.asarray(values, dtype=np.float64)
+        return np.ones(values.shape + (3,))
+
+    def max_density(self, vmin, vmax):
+        return self.scale * max(float(vmax), 0.0)
+
+    @property
+    def code(self):
+        return (_k.GLOW, self.scale, 0.0, 1.0, np.zeros(2), np.ones((2, 3)))
+
+    def __repr__(self):
+        shading = "" if self.shading is None else f", shading={self.shading!r}"
+        return f"Glow({self.scale:g}{shading})"
+
+
+class LookupTransfer(TransferFunction):
+    """Tabulated transfer function: density and colour at evenly spaced values, interpolated.
+
+    Values below ``value_range[0]`` or above ``value_range[1]`` take the end entries.
+
+    Parameters
+    ----------
+    density : array_like, shape (n,)
+        Opacity density per world unit at ``n >= 2`` evenly spaced values; finite, >= 0.
+    color : array_like, shape (n, 3), optional
+        Emitted RGB at the same values, finite and >= 0; default white.
+    value_range : pair of float, default (0, 1)
+        The values of the first and last entries (first < last).
+    shading : Phong, optional
+
+    Examples
+    --------
+    >>> tf = LookupTransfer([0.0, 4.0], value_range=(0.0, 2.0))
+    >>> tf.opacity_density(np.array([-1.0, 0.5, 3.0])).tolist()
+    [0.0, 1.0, 4.0]
+    >>> tf.max_density(0.0, 1.0)
+    2.0
+    """
+
+    def __init__(self, density, color=None, *, value_range=(0.0, 1.0), shading=None):
+        dens = _validate.finite_array("density", density, ndim=1)
+        if dens.shape[0] < 2:
+            raise ValueError(f"density table needs at least 2 entries, got {dens.shape[0]}")
+        if np.any(dens < 0.0):
+            raise ValueError("density table entries must be >= 0 (opacity density per unit)")
+        if color is None:
+            col = np.ones((dens.shape[0], 3))
+        else:
+            col = _validate.finite_array("color", color, ndim=2)
+            if col.shape != (dens.shape[0], 3):
+                raise ValueError(
+                    f"color table must have shape ({dens.shape[0]}, 3) to match the density "
+                    f"table, got {col.shape}"
+                )
+            if np.any(col < 0.0):
+                raise ValueError("color table entries must be >= 0")
+        lo = _validate.finite_number("value_range[0]", value_range[0])
+        hi = _validate.finite_number("value_range[1]", value_range[1])
+        if not hi > lo:
+            raise ValueError(f"value_range must be increasing (low < high), got ({lo}, {hi})")
+        self.density = dens
+        self.color = np.ascontiguousarray(col)
+        self.value_range = (lo, hi)
+        self.shading = _check_shading(shading)
+
+    @classmethod
+    def from_alpha(cls, alpha, color=None, *, unit_distance=1.0, value_range=(0.0, 1.0),
+                   shading=None):
+        """Build from opacities per ``unit_distance`` (as VTK's scalar opacity defines them).
+
+        ``alpha`` in [0, 1) becomes density ``-ln(1 - alpha) / unit_distance``.
+
+        Examples
+        --------
+        >>> tf = LookupTransfer.from_alpha([0.0, 1 - np.exp(-2.0)], unit_distance=0.5)
+        >>> np.round(tf.density, 12).tolist()
+        [0.0, 4.0]
+        """
+        a = _validate.finite_array("alpha", alpha, ndim=1)
+        if np.any((a < 0.0) | (a >= 1.0)):
+            raise ValueError("alpha entries must lie in [0, 1) (1 would be infinite density)")
+        unit = _validate.positive_number("unit_distance", unit_distance)
+        return cls(-np.log1p(-a) / unit, color, value_range=value_range, shading=shading)
+
+    def _interp(self, table, values):
+        values = np.asarray(values, dtype=np.float64)
+        grid = np.linspace(*self.value_range, table.shape[0])
+        return np.interp(values, grid, table)
+
+    def opacity_density(self, values):
+        return self._interp(self.density, values)
+
+    def emission(self, values):
+        return np.stack([self._interp(self.color[:, c], values) for c in range(3)], axis=-1)
+
+    def max_density(self, vmin, vmax):
+        lo, hi = self.value_range
+        grid = np.linspace(lo, hi, self.density.shape[0])
+        inside = self.density[(grid > vmin) & (grid < vmax)]
+        ends = self.opacity_density(np.array([vmin, vmax]))
+        return float(max(ends.max(), inside.max(initial=0.0)))
+
+    @property
+    def code(self):
+        return (_k.TABLE, 1.0, *self.value_range, self.density, self.color)
+
+    def __repr__(self):
+        return f"LookupTransfer(<{self.density.shape[0]} entries>, value_range={self.value_range})"

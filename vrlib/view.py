@@ -1,0 +1,279 @@
+"""The view: camera placement, projection and the image lattice.
+
+A view looks along ``forward`` at ``center``; ``right`` and ``up`` span the image plane, with
+image columns increasing along ``right`` and rows increasing *down* (row 0 at the top). Pixel
+``(row, col)`` has its centre at continuous image coordinates ``(row + 0.5, col + 0.5)``.
+The basis is right-handed: ``right x up = -forward`` (the camera looks down its own -z axis,
+as in OpenGL).
+
+At ``zoom = 1`` the shorter image side spans the diameter of the scene sphere (``center``,
+``radius``; by default the bounding sphere of the cube [-1, 1]^3), so every orbit sees the
+whole volume. Orthographic rays start on the plane tangent to that sphere nearest the viewer;
+perspective rays start at the eye.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from vrlib import _validate
+
+__all__ = ["View", "PROJECTIONS"]
+
+#: Projections accepted by :class:`View`.
+PROJECTIONS = ("orthographic", "perspective")
+
+_MAX_SIZE = 16384
+_DEFAULT_RADIUS = math.sqrt(3.0)
+
+
+def _image_size(size):
+    if isinstance(size, tuple | list):
+        if len(size) != 2:
+            raise ValueError(f"size must be an int or a (height, width) pair, got {size!r}")
+        h = _validate.positive_int("size[0] (height)", size[0])
+        w = _validate.positive_int("size[1] (width)", size[1])
+    else:
+        h = w = _validate.positive_int("size", size)
+    if max(h, w) > _MAX_SIZE:
+        raise ValueError(f"size must be at most {_MAX_SIZE} pixels per side, got ({h}, {w})")
+    return h, w
+
+
+class View:
+    """A camera: direction, image size, projection and framing of a scene sphere.
+
+    Most users build one with :meth:`orbit`; this constructor takes the direction directly.
+
+    Parameters
+    ----------
+    forward : array_like of 3 floats
+        Viewing direction (from the eye towards the scene); normalised here.
+    up : array_like of 3 floats, default (0, 0, 1)
+        A world direction that appears upward in the image; must not be parallel to
+        ``forward``.
+    size : int or (int, int), default 256
+        Image size in pixels: ``n`` for ``n x n`` or ``(height, width)``.
+    center : array_like of 3 floats, default (0, 0, 0)
+        The point looked at; the centre of the scene sphere.
+    radius : float, default sqrt(3)
+        Radius of the scene sphere (``sqrt(3)`` bounds [-1, 1]^3; use
+        ``volume.bounding_radius`` for other volumes).
+    projection : {"orthographic", "perspective"}
+    zoom : float, default 1.0
+        Magnification (> 0): at 1 the shorter image side spans the sphere's diameter.
+    fov : float, optional
+        Perspective only: full angle in degrees, in (0, 180), seen by the shorter image side at
+        ``zoom = 1``. Default: the angle the scene sphere subtends from the eye.
+    distance : float, optional
+        Perspective only: distance from the eye to ``center``; default ``4 * radius``. Without
+        ``fov`` the eye must be outside the scene sphere.
+
+    Raises
+    ------
+    ValueError
+        Zero or non-finite vectors, ``up`` parallel to ``forward``, a non-positive size, zoom,
+        radius or distance, an unknown projection, ``fov`` outside (0, 180), or a perspective
+        eye inside the scene sphere with no ``fov`` to frame it.
+
+    Examples
+    --------
+    >>> view = View([0, 0, -1], up=[0, 1, 0], size=4)
+    >>> view.basis.tolist()
+    [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, -1.0]]
+    >>> round(view.pixel_size, 6)          # 2 sqrt(3) / 4
+    0.866025
+    """
+
+    def __init__(self, forward, up=(0.0, 0.0, 1.0), *, size=256, center=(0.0, 0.0, 0.0),
+                 radius=_DEFAULT_RADIUS, projection="orthographic", zoom=1.0, fov=None,
+                 distance=None):
+        f = _validate.vector3("forward", forward, unit=True)
+        up = _validate.vector3("up", up, unit=True)
+        right = np.cross(f, up)
+        if np.linalg.norm(right) < 1e-9:
+            raise ValueError(
+                f"up {up.tolist()} is parallel to the view direction {f.tolist()}; "
+                "give an up vector across the view"
+            )
+        right /= np.linalg.norm(right)
+        self._basis = np.array([right, np.cross(right, f), f])
+        self._basis.flags.writeable = False
+        self.height, self.width = _image_size(size)
+        self.center = _validate.vector3("center", center)
+        self.radius = _validate.positive_number("radius", radius)
+        self.projection = _validate.choice("projection", projection, PROJECTIONS)
+        self.zoom = _validate.positive_number("zoom", zoom)
+        if self.projection == "orthographic":
+            if fov is not None or distance is not None:
+                raise ValueError("fov and distance apply to the perspective projection only")
+            self.fov = self.distance = None
+            # Width of one pixel on the image plane, in world units.
+            self._pixel = 2.0 * self.radius / (self.zoom * min(self.height, self.width))
+        else:
+            if distance is None:
+                distance = 4.0 * self.radius
+            self.distance = _validate.positive_number("distance", distance)
+            if fov is None:
+                if self.distance <= self.radius:
+                    raise ValueError(
+                        f"the eye (distance {self.distance:g}) is inside the scene sphere "
+                        f"(radius {self.radius:g}): give fov explicitly or move the eye out"
+                    )
+                fov = 2.0 * math.degrees(math.asin(self.radius / self.distance))
+            self.fov = _validate.finite_number("fov", fov, low=0.0, high=180.0,
+                                               low_open=True, high_open=True)
+            half = math.tan(math.radians(self.fov) / 2.0) / self.zoom
+            # Width of one pixel on the plane one world unit in front of the eye.
+            self._pixel = 2.0 * half / min(self.height, self.width)
+        self._pixel_size = self._pixel if self.distance is None else self._pixel * self.distance
+
+    @classmethod
+    def orbit(cls, *, azimuth=0.0, elevation=0.0, size=256, projection="orthographic",
+              zoom=1.0, fov=None, distance=None, center=(0.0, 0.0, 0.0),
+              radius=_DEFAULT_RADIUS):
+        """A view from a point on a sphere around ``center``, world z up.
+
+        The eye lies in direction ``(cos e cos a, cos e sin a, sin e)`` from the centre
+        (``a`` azimuth about z from +x, ``e`` elevation above the xy plane, in degrees) and
+        looks at the centre. Image right is ``(-sin a, cos a, 0)`` at every elevation, so views
+        straight down (``e = 90``) are well defined. Other parameters as for :class:`View`.
+
+        Examples
+        --------
+        >>> view = View.orbit(azimuth=0, elevation=0, size=8)
+        >>> view.basis.round(12).tolist()     # right, up, forward
+        [[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [-1.0, 0.0, 0.0]]
+        >>> View.orbit(elevation=90, size=8).forward.round(12).tolist()
+        [-0.0, -0.0, -1.0]
+        """
+        a = math.radians(_validate.finite_number("azimuth", azimuth))
+        e = math.radians(_validate.finite_number("elevation", elevation))
+        eye_dir = np.array([math.cos(e) * math.cos(a), math.cos(e) * math.sin(a), math.sin(e)])
+        right = np.array([-math.sin(a), math.cos(a), 0.0])
+        up = np.cross(right, -eye_dir)
+        return cls(-eye_dir, up, size=size, center=center, radius=radius,
+                   projection=projection, zoom=zoom, fov=fov, distance=distance)
+
+    # -- geometry --------------------------------------------------------------------------
+
+    @property
+    def basis(self):
+        """Rows ``right, up, forward`` (world unit vectors)."""
+        return self._basis
+
+    @property
+    def right(self):
+        """World direction of increasing image column."""
+        return self._basis[0]
+
+    @property
+    def up(self):
+        """World direction of decreasing image row."""
+        return self._basis[1]
+
+    @property
+    def forward(self):
+        """Viewing direction (towards the scene)."""
+        return self._basis[2]
+
+    @property
+    def shape(self):
+        """``(height, width)`` of the image in pixels."""
+        return (self.height, self.width)
+
+    @property
+    def is_perspective(self):
+        """True for the perspective projection."""
+        return self.projection == "perspective"
+
+    @property
+    def eye(self):
+        """Eye position (perspective) or ``None`` (orthographic: the eye is at infinity)."""
+        if self.distance is None:
+            return None
+        return self.center - self.distance * self.forward
+
+    @property
+    def pixel_size(self):
+        """World units per pixel: on the image plane (orthographic), or at ``center``
+        (perspective)."""
+        return self._pixel_size
+
+    def _plane_offsets(self):
+        """Offsets of pixel centres along ``right`` (per column) and ``up`` (per row)."""
+        cols = (np.arange(self.width) + 0.5 - 0.5 * self.width) * self._pixel
+        rows = (0.5 * self.height - np.arange(self.height) - 0.5) * self._pixel
+        return rows, cols
+
+    def rays(self):
+        """One ray per pixel centre: ``(origins, directions)``, each ``(height, width, 3)``.
+
+        Directions are unit vectors. Orthographic origins lie on the plane tangent to the scene
+        sphere nearest the viewer, so the sphere spans ray parameters ``[0, 2 * radius]``;
+        perspective origins are the eye.
+
+        Examples
+        --------
+        >>> o, d = View([0, 0, -1], up=[0, 1, 0], size=2, radius=1.0).rays()
+        >>> o[0, 0].tolist(), d[0, 0].tolist()
+        ([-0.5, 0.5, 1.0], [0.0, 0.0, -1.0])
+        """
+        rows, cols = self._plane_offsets()
+        r, u, f = self._basis
+        offsets = rows[:, None, None] * u + cols[None, :, None] * r
+        if self.distance is None:
+            origins = self.center - self.radius * f + offsets
+            directions = np.broadcast_to(f, origins.shape).copy()
+        else:
+            directions = f + offsets
+            directions /= np.linalg.norm(directions, axis=-1, keepdims=True)
+            origins = np.broadcast_to(self.eye, directions.shape).copy()
+        return origins, directions
+
+    def to_camera(self, points):
+        """World points ``(..., 3)`` to camera coordinates ``(right, up, depth)``.
+
+        Depth is measured along ``forward`` from the ray-origin plane (orthographic) or from
+        the eye (perspective).
+
+        Examples
+        --------
+        >>> View([0, 0, -1], up=[0, 1, 0], radius=1.0).to_camera([0.5, 0.25, 0.0]).tolist()
+        [0.5, 0.25, 1.0]
+        """
+        p = np.asarray(points, dtype=np.float64)
+        start = self.center - self.radius * self.forward if self.eye is None else self.eye
+        return (p - start) @ self._basis.T
+
+    def project(self, points):
+        """World points ``(..., 3)`` to continuous image coordinates ``(row, col, depth)``.
+
+        Pixel ``(r, c)`` covers ``[r, r + 1) x [c, c + 1)``; points behind a perspective eye
+        get ``nan`` image coordinates.
+
+        Examples
+        --------
+        >>> view = View([0, 0, -1], up=[0, 1, 0], size=2, radius=1.0)
+        >>> view.project([[0.0, 0.0, 0.0], [-0.5, 0.5, 0.0]]).tolist()
+        [[1.0, 1.0, 1.0], [0.5, 0.5, 1.0]]
+        """
+        cam = self.to_camera(points)
+        x, y, depth = cam[..., 0], cam[..., 1], cam[..., 2]
+        if self.distance is not None:
+            with np.errstate(divide="ignore", invalid="ignore"):
+                scale = np.where(depth > 0.0, 1.0 / depth, np.nan)
+            x, y = x * scale, y * scale
+        col = x / self._pixel + 0.5 * self.width
+        row = 0.5 * self.height - y / self._pixel
+        return np.stack([row, col, depth], axis=-1)
+
+    def __repr__(self):
+        f = ", ".join(f"{v:.4g}" for v in self.forward)
+        extra = "" if self.distance is None else f", fov={self.fov:.4g}, distance={self.distance:g}"
+        return (
+            f"View(forward=[{f}], size=({self.height}, {self.width}), "
+            f"projection={self.projection!r}, zoom={self.zoom:g}{extra})"
+        )

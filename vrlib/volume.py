@@ -1,0 +1,299 @@
+"""The sampled volume: samples on a regular lattice inside a world box.
+
+Samples are stored as ``data[z, y, x]`` and sit at the corners of the world box and evenly
+between them (vertex-centred), so sample ``(i, j, k)`` (x, y, z index) lies at
+``origin + (i, j, k) * spacing``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage
+
+from vrlib import _validate
+
+__all__ = ["Volume", "MinMaxPyramid", "DEFAULT_EXTENT"]
+
+#: The default world box, ``[[xmin, xmax], [ymin, ymax], [zmin, zmax]]``: the cube [-1, 1]^3.
+DEFAULT_EXTENT = ((-1.0, 1.0), (-1.0, 1.0), (-1.0, 1.0))
+
+# Integer and small float types that float32 represents exactly are kept in float32;
+# everything else is stored in float64.
+_EXACT_IN_FLOAT32 = {np.dtype(t) for t in ("int8", "uint8", "int16", "uint16", "float16", "float32")}
+
+
+@dataclass(frozen=True)
+class MinMaxPyramid:
+    """Per-block minimum and maximum of a volume's samples, at successively coarser levels.
+
+    Level 0 splits the volume's cells into blocks of ``block`` cells per axis; block
+    ``(bz, by, bx)`` holds the minimum and maximum over the samples whose indices lie in
+    ``[block * b - margin, block * (b + 1) + margin]`` along each axis (clipped to the volume).
+    Each further level merges 2 x 2 x 2 blocks of the one below. ``margin`` widens every block
+    by the reach of a reconstruction filter, so a block whose range maps to zero opacity is
+    empty for every point inside it.
+
+    Attributes
+    ----------
+    block : int
+        Cells per block along each axis at level 0.
+    margin : int
+        Extra samples included on each side of a block.
+    minimum, maximum : list of ndarray
+        ``minimum[level][bz, by, bx]`` and likewise ``maximum``.
+    """
+
+    block: int
+    margin: int
+    minimum: list
+    maximum: list
+
+    @property
+    def levels(self):
+        """Number of levels (level 0 is the finest)."""
+        return len(self.minimum)
+
+    def cells_per_block(self, level):
+        """Cells along each axis covered by one block at ``level``."""
+        return self.block << level
+
+
+class Volume:
+    """Scalar samples ``data[z, y, x]`` on a regular lattice spanning a world box.
+
+    Parameters
+    ----------
+    data : array_like, shape (nz, ny, nx)
+        Real, finite samples; every dimension at least 2. Types that float32 holds exactly
+        (8- and 16-bit integers, float16, float32) are stored as float32, all others as float64.
+    extent : array_like, shape (3, 2), optional
+        World box ``[[xmin, xmax], [ymin, ymax], [zmin, zmax]]``; default the cube [-1, 1]^3.
+        Samples lie on its corners and evenly between them.
+    copy : bool, default True
+        Copy ``data``. With ``copy=False`` an array that already has the storage type is used
+        as is (read-only view): do not modify it afterwards.
+
+    Raises
+    ------
+    ValueError
+        Non-finite samples, not exactly 3 dimensions, a dimension below 2, or an extent that is
+        empty, inverted or non-finite.
+    TypeError
+        A non-numeric (or boolean, or complex) dtype.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> vol = Volume(np.zeros((3, 4, 5)))
+    >>> vol.shape
+    (3, 4, 5)
+    >>> vol.spacing.tolist()          # (dx, dy, dz) in world units
+    [0.5, 0.6666666666666666, 1.0]
+    >>> vol.index_to_world([4, 3, 2]).tolist()
+    [1.0, 1.0, 1.0]
+    """
+
+    def __init__(self, data, extent=None, *, copy=True):
+        arr = np.asarray(data)
+        if arr.dtype.kind not in "iuf":
+            raise TypeError(
+                "volume data must be real numbers (integer or float dtype), "
+                f"got dtype {arr.dtype}"
+            )
+        if arr.ndim != 3:
+            raise ValueError(
+                f"volume data must be 3-dimensional [z, y, x], got {arr.ndim} "
+                f"dimension(s) with shape {arr.shape}"
+            )
+        if min(arr.shape) < 2:
+            raise ValueError(
+                f"volume data needs at least 2 samples along every axis, got shape {arr.shape}"
+            )
+        storage = np.float32 if arr.dtype in _EXACT_IN_FLOAT32 else np.float64
+        arr = np.array(arr, dtype=storage, order="C", copy=True if copy else None)
+        if not np.all(np.isfinite(arr)):
+            bad = int(arr.size - np.count_nonzero(np.isfinite(arr)))
+            raise ValueError(f"volume data must be finite: found {bad} NaN or infinite sample(s)")
+        if arr.base is not None or not copy:
+            arr = arr.view()
+        arr.flags.writeable = False
+        self._data = arr
+        self._extent = _check_extent(DEFAULT_EXTENT if extent is None else extent)
+        self._pyramids = {}
+
+    # -- lattice geometry ------------------------------------------------------------------
+
+    @property
+    def data(self):
+        """Read-only samples, indexed ``[z, y, x]``."""
+        return self._data
+
+    @property
+    def shape(self):
+        """``(nz, ny, nx)``."""
+        return self._data.shape
+
+    @property
+    def dtype(self):
+        """Storage dtype (float32 or float64)."""
+        return self._data.dtype
+
+    @property
+    def extent(self):
+        """World box ``[[xmin, xmax], [ymin, ymax], [zmin, zmax]]`` (a copy)."""
+        return self._extent.copy()
+
+    @property
+    def origin(self):
+        """World position ``(x, y, z)`` of sample ``data[0, 0, 0]``."""
+        return self._extent[:, 0].copy()
+
+    @property
+    def spacing(self):
+        """World distance between neighbouring samples along ``(x, y, z)``."""
+        counts = np.array(self.shape[::-1], dtype=np.float64) - 1.0
+        return (self._extent[:, 1] - self._extent[:, 0]) / counts
+
+    @property
+    def center(self):
+        """Centre ``(x, y, z)`` of the world box."""
+        return self._extent.mean(axis=1)
+
+    @property
+    def bounding_radius(self):
+        """Radius of the sphere around :attr:`center` that contains the world box.
+
+        Pass it (with :attr:`center`) to :meth:`vrlib.View.orbit` to frame this volume.
+        """
+        return float(0.5 * np.linalg.norm(self._extent[:, 1] - self._extent[:, 0]))
+
+    @property
+    def value_range(self):
+        """``(min, max)`` of the samples."""
+        return float(self._data.min()), float(self._data.max())
+
+    def index_to_world(self, index):
+        """Map index coordinates ``(i, j, k)`` (x, y, z order, float) to world ``(x, y, z)``.
+
+        Examples
+        --------
+        >>> Volume(np.zeros((2, 2, 2))).index_to_world([0.5, 0, 1]).tolist()
+        [0.0, -1.0, 1.0]
+        """
+        return self._extent[:, 0] + np.asarray(index, dtype=np.float64) * self.spacing
+
+    def world_to_index(self, points):
+        """Map world ``(x, y, z)`` points (last axis) to float index coordinates ``(i, j, k)``.
+
+        Examples
+        --------
+        >>> Volume(np.zeros((5, 5, 5))).world_to_index([0.0, 0.0, 1.0]).tolist()
+        [2.0, 2.0, 4.0]
+        """
+        return (np.asarray(points, dtype=np.float64) - self._extent[:, 0]) / self.spacing
+
+    # -- empty-space skipping --------------------------------------------------------------
+
+    def minmax_pyramid(self, block=8, *, margin=0):
+        """Min-max block pyramid for empty-space skipping, built on first use and cached.
+
+        Parameters
+        ----------
+        block : int, default 8
+            Cells per block along each axis at the finest level (>= 1).
+        margin : int, default 0
+            Samples added on each side of every block: a filter of support radius ``r``
+            voxels reaches ``ceil(r) - 1`` samples beyond a cell's corners.
+
+        Returns
+        -------
+        MinMaxPyramid
+
+        Examples
+        --------
+        >>> data = np.zeros((9, 9, 9)); data[8, 8, 8] = 1.0
+        >>> pyr = Volume(data).minmax_pyramid(4)
+        >>> pyr.maximum[0].tolist()[1][1], pyr.levels
+        ([0.0, 1.0], 2)
+        """
+        block = _validate.positive_int("block", block)
+        margin = _validate.positive_int("margin", margin, minimum=0)
+        key = (block, margin)
+        if key not in self._pyramids:
+            self._pyramids[key] = _build_pyramid(self._data, block, margin)
+        return self._pyramids[key]
+
+    def __repr__(self):
+        ext = ", ".join(f"[{lo:g}, {hi:g}]" for lo, hi in self._extent)
+        return f"Volume(shape={self.shape}, dtype={self.dtype}, extent=[{ext}])"
+
+
+def _check_extent(extent):
+    try:
+        ext = np.array(extent, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise TypeError(f"extent must be 3 pairs of real numbers, got {extent!r}") from None
+    if ext.shape != (3, 2):
+        raise ValueError(
+            f"extent must have shape (3, 2): [[xmin, xmax], [ymin, ymax], [zmin, zmax]], "
+            f"got shape {ext.shape}"
+        )
+    if not np.all(np.isfinite(ext)):
+        raise ValueError(f"extent must be finite, got {ext.tolist()}")
+    for axis, (lo, hi) in zip("xyz", ext, strict=True):
+        if not hi > lo:
+            kind = "empty" if hi == lo else "inverted"
+            raise ValueError(
+                f"extent along {axis} is {kind}: [{lo:g}, {hi:g}]; it needs {axis}min < {axis}max"
+            )
+    ext.flags.writeable = False
+    return ext
+
+
+def _block_reduce_1d(arr, axis, block, reduce):
+    """Reduce blocks of ``block`` cells along ``axis``, each including both end samples."""
+    n = arr.shape[axis]
+    nblocks = -(-(n - 1) // block)
+    pad = nblocks * block + 1 - n
+    widths = [(0, 0)] * arr.ndim
+    widths[axis] = (0, pad)
+    padded = np.pad(arr, widths, mode="edge")
+    body = np.take(padded, np.arange(nblocks * block), axis=axis)
+    shape = list(body.shape)
+    shape[axis : axis + 1] = [nblocks, block]
+    inner = reduce(body.reshape(shape), axis=axis + 1)
+    ends = np.take(padded, np.arange(1, nblocks + 1) * block, axis=axis)
+    return reduce(np.stack([inner, ends]), axis=0)
+
+
+def _merge_2x2x2(arr, reduce):
+    for axis in range(3):
+        if arr.shape[axis] % 2:
+            widths = [(0, 0)] * 3
+            widths[axis] = (0, 1)
+            arr = np.pad(arr, widths, mode="edge")
+        shape = list(arr.shape)
+        shape[axis : axis + 1] = [arr.shape[axis] // 2, 2]
+        arr = reduce(arr.reshape(shape), axis=axis + 1)
+    return arr
+
+
+def _build_pyramid(data, block, margin):
+    levels = {}
+    for name, reduce, window in (
+        ("minimum", np.min, ndimage.minimum_filter),
+        ("maximum", np.max, ndimage.maximum_filter),
+    ):
+        arr = np.asarray(data, dtype=np.float64)
+        if margin:
+            # Widen every sample's reach by `margin` before the block reduction (separable).
+            arr = window(arr, size=2 * margin + 1, mode="nearest")
+        for axis in range(3):
+            arr = _block_reduce_1d(arr, axis, block, reduce)
+        stack = [arr]
+        while max(stack[-1].shape) > 1:
+            stack.append(_merge_2x2x2(stack[-1], reduce))
+        levels[name] = stack
+    return MinMaxPyramid(block, margin, levels["minimum"], levels["maximum"])
