@@ -51,7 +51,7 @@ results: $(RESULTS)
 build/stamps/%.done: chapters/%.py $(LIBRARY) $(CHAPTER_COMMON) $(INSTALLED)
 	@mkdir -p $(@D)
 	@echo "[chapters] $*"
-	$(PY) chapters/$*.py
+	$(PY) -m chapters.$(subst /,.,$*)
 	@touch $@
 
 # fig_* and tab_* scripts also read what the run_* scripts of their chapter wrote.

@@ -49,8 +49,8 @@ def load_npy(path, *, extent=None):
     >>> load_npy(f).shape
     (2, 3, 4)
     """
-    data = np.load(_existing(path), allow_pickle=False)
-    return Volume(data, fitted_extent(data.shape) if extent is None else extent, copy=False)
+    vol = Volume(np.load(_existing(path), allow_pickle=False), extent, copy=False)
+    return vol if extent is not None else Volume(vol.data, fitted_extent(vol.shape), copy=False)
 
 
 def load_raw(path, shape, dtype, *, byteorder="little", offset=0, extent=None):
@@ -109,6 +109,15 @@ def load_nifti(path, *, physical=False):
 
     Voxel axes ``(i, j, k)`` become ``(x, y, z)``; the voxel sizes set the aspect. With
     ``physical=True`` the world box is in the file's units (mm), centred on the origin.
+
+    Examples
+    --------
+    >>> import nibabel, tempfile, pathlib
+    >>> f = pathlib.Path(tempfile.mkdtemp()) / "v.nii.gz"
+    >>> nibabel.save(nibabel.Nifti1Image(np.zeros((5, 3, 2), np.float32), np.eye(4)), f)
+    >>> vol = load_nifti(f)
+    >>> vol.shape, vol.extent[0].tolist()
+    ((2, 3, 5), [-1.0, 1.0])
     """
     import nibabel
 
@@ -122,6 +131,11 @@ def load_mni_template(*, resolution=2, physical=False):
     ------
     ImportError
         If nilearn is not installed (``pip install 'vrlib[mri]'``).
+
+    Examples
+    --------
+    >>> load_mni_template().shape        # [z, y, x] at 2 mm
+    (95, 117, 99)
     """
     try:
         from nilearn.datasets import load_mni152_template
@@ -139,6 +153,14 @@ def load(source, **options):
 
     ``.npy`` -> :func:`load_npy`; ``.nii``/``.nii.gz`` -> :func:`load_nifti`; ``.raw`` ->
     :func:`load_raw` (``shape`` and ``dtype`` required in ``options``).
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> f = pathlib.Path(tempfile.mkdtemp()) / "v.raw"
+    >>> np.ones(8, dtype=np.float32).tofile(f)
+    >>> load(f, shape=(2, 2, 2), dtype="float32").value_range
+    (1.0, 1.0)
     """
     if str(source) == "mni152":
         return load_mni_template(**options)

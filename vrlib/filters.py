@@ -251,6 +251,7 @@ class MitchellNetravali(_Piecewise):
 
     @property
     def interpolating(self):
+        """True when ``B = 0``: the kernel is 1 at 0 and 0 at the other integers."""
         return self.B == 0.0
 
     @property

@@ -28,6 +28,11 @@ class RenderStats:
         Bytes of the largest buffers the renderer held.
     seconds : float
         Wall time of the render.
+
+    Examples
+    --------
+    >>> RenderStats(samples=10, seconds=0.5).as_dict()
+    {'samples': 10, 'operations': 0, 'bytes': 0, 'seconds': 0.5}
     """
 
     samples: int = 0

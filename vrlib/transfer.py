@@ -118,8 +118,8 @@ class Glow(TransferFunction):
     A pixel's value is then its opacity ``1 - exp(-scale * tau)`` with ``tau`` the line
     integral of the field along its ray, and the image is grey (premultiplied RGB = alpha).
 
-    # Deviation from thesis: negative reconstructed values (a cubic's overshoot) are clamped
-    # to zero density, so that opacity stays in [0, 1].
+    Deviation from thesis: negative reconstructed values (a cubic's overshoot below zero) are
+    clamped to zero density, so that opacity stays in [0, 1].
 
     Parameters
     ----------

@@ -43,6 +43,13 @@ class MinMaxPyramid:
         Extra samples included on each side of a block.
     minimum, maximum : list of ndarray
         ``minimum[level][bz, by, bx]`` and likewise ``maximum``.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> pyr = Volume(np.arange(27.0).reshape(3, 3, 3)).minmax_pyramid(1)
+    >>> pyr.levels, pyr.minimum[0].shape, pyr.maximum[-1].item()
+    (2, (2, 2, 2), 26.0)
     """
 
     block: int
@@ -286,7 +293,7 @@ def _build_pyramid(data, block, margin):
         ("minimum", np.min, ndimage.minimum_filter),
         ("maximum", np.max, ndimage.maximum_filter),
     ):
-        arr = np.asarray(data, dtype=np.float64)
+        arr = data  # min and max are exact in the storage type
         if margin:
             # Widen every sample's reach by `margin` before the block reduction (separable).
             arr = window(arr, size=2 * margin + 1, mode="nearest")
