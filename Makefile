@@ -34,7 +34,7 @@ RESULTS := $(call stamp,$(RUNS) $(PLOTS))
 DOCS := $(shell find docs -type f -not -path 'docs/_build/*')
 REPORT := build/report/html/index.html
 
-.PHONY: all venv results report test test-all bench clean distclean
+.PHONY: all venv results report test test-all bench lint clean distclean
 
 all: results report
 
@@ -73,13 +73,16 @@ test: $(INSTALLED)
 # Everything, slow checks included, then the whole suite again with the JIT off so the numba
 # kernels run as plain Python.
 test-all: $(INSTALLED)
-	$(PY) -m pytest
+	HYPOTHESIS_PROFILE=thorough $(PY) -m pytest
 	NUMBA_DISABLE_JIT=1 $(PY) -m pytest -m "not slow" tests
 
 bench: $(INSTALLED)
 	$(PY) -m pytest benchmarks --benchmark-enable --benchmark-only --benchmark-columns=min,median,max,rounds
 	@for script in benchmarks/bench_*.py; do [ -e "$$script" ] || continue; \
 		echo "== $$script"; $(PY) "$$script"; done
+
+lint: $(INSTALLED)
+	$(PY) -m ruff check .
 
 clean:
 	rm -rf build figures docs/_build

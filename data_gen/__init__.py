@@ -6,8 +6,6 @@
 (16, 16, 16)
 """
 
-from vrlib import _validate
-
 from data_gen.fields import (
     BlobSum,
     Field,
@@ -25,6 +23,7 @@ from data_gen.loaders import (
     load_npy,
     load_raw,
 )
+from vrlib import _validate
 
 #: Field constructors by name.
 FIELDS = {

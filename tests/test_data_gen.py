@@ -111,7 +111,7 @@ def test_sampling_in_chunks_matches_direct(monkeypatch):
 @pytest.mark.parametrize(
     "call, error, message",
     [
-        (lambda: make_field("sphere"), ValueError, "unknown field 'sphere'; known: 'gaussian-blob'"),
+        (lambda: make_field("sphere"), ValueError, "unknown field .sphere.; known: .gaussian"),
         (lambda: make_field("gaussian-blob", width=1), TypeError, "bad parameters for field"),
         (lambda: make_field("gaussian-blob", sigma=0), ValueError, "sigma must be > 0"),
         (lambda: make_field("grating", direction=(0, 0, 0)), ValueError, "non-zero vector"),

@@ -94,7 +94,7 @@ def naive_block_range(data, block, margin, reduce):
     return out
 
 
-@settings(max_examples=25, deadline=None)
+@settings(max_examples=25)
 @given(
     data=hnp.arrays(np.float64, hnp.array_shapes(min_dims=3, max_dims=3, min_side=2,
                                                  max_side=11),

@@ -243,10 +243,12 @@ class MitchellNetravali(_Piecewise):
         self.C = _validate.finite_number("C", C)
         self.name = name
         b, c = self.B, self.C
+        # The two cubic pieces of the brief's formula, divided by 6, ascending powers.
+        near = (6 - 2 * b, 0.0, -18 + 12 * b + 6 * c, 12 - 9 * b - 6 * c)
+        far = (8 * b + 24 * c, -12 * b - 48 * c, 6 * b + 30 * c, -b - 6 * c)
         self.pieces = (
-            (0.0, 1.0, ((6 - 2 * b) / 6, 0.0, (-18 + 12 * b + 6 * c) / 6, (12 - 9 * b - 6 * c) / 6)),
-            (1.0, 2.0, ((8 * b + 24 * c) / 6, (-12 * b - 48 * c) / 6, (6 * b + 30 * c) / 6,
-                        (-b - 6 * c) / 6)),
+            (0.0, 1.0, tuple(v / 6 for v in near)),
+            (1.0, 2.0, tuple(v / 6 for v in far)),
         )
 
     @property
@@ -396,7 +398,9 @@ def make_filter(spec, *args, **params):
             raise ValueError("filter tuple must start with a filter name")
         spec, args = spec[0], tuple(spec[1:]) + args
     if not isinstance(spec, str):
-        raise TypeError(f"filter must be a name, a (name, *params) tuple or a Filter, got {spec!r}")
+        raise TypeError(
+            f"filter must be a name, a (name, *params) tuple or a Filter, got {spec!r}"
+        )
     _validate.choice("filter", spec, tuple(FILTERS))
     try:
         return FILTERS[spec](*args, **params)

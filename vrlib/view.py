@@ -272,7 +272,9 @@ class View:
 
     def __repr__(self):
         f = ", ".join(f"{v:.4g}" for v in self.forward)
-        extra = "" if self.distance is None else f", fov={self.fov:.4g}, distance={self.distance:g}"
+        extra = ""
+        if self.distance is not None:
+            extra = f", fov={self.fov:.4g}, distance={self.distance:g}"
         return (
             f"View(forward=[{f}], size=({self.height}, {self.width}), "
             f"projection={self.projection!r}, zoom={self.zoom:g}{extra})"

@@ -21,7 +21,9 @@ DEFAULT_EXTENT = ((-1.0, 1.0), (-1.0, 1.0), (-1.0, 1.0))
 
 # Integer and small float types that float32 represents exactly are kept in float32;
 # everything else is stored in float64.
-_EXACT_IN_FLOAT32 = {np.dtype(t) for t in ("int8", "uint8", "int16", "uint16", "float16", "float32")}
+_EXACT_IN_FLOAT32 = {
+    np.dtype(t) for t in ("int8", "uint8", "int16", "uint16", "float16", "float32")
+}
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,16 @@
+"""Test-suite configuration.
+
+Hypothesis profiles: ``default`` (``make test``: bounded examples, no per-example deadline,
+since a first call may include a JIT compile) and ``thorough`` (``make test-all``), chosen with
+``HYPOTHESIS_PROFILE``.
+"""
+
+import os
+
+from hypothesis import HealthCheck, settings
+
+settings.register_profile("default", max_examples=60, deadline=None,
+                          suppress_health_check=[HealthCheck.too_slow])
+settings.register_profile("thorough", max_examples=500, deadline=None,
+                          suppress_health_check=[HealthCheck.too_slow])
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "default"))
