@@ -76,6 +76,11 @@ class Field:
         [t0, t1]."""
         raise NotImplementedError(f"{self.name} has no closed-form line integral")
 
+    def breakpoints(self, origins, directions):
+        """Ray parameters ``(n_rays, m)`` where the field jumps or kinks along each ray
+        (``nan`` for none), or ``None`` for a smooth field. Quadrature splits there."""
+        return None
+
     def integral(self, extent=None):
         """Exact integral of the field over a world box (default: all of space)."""
         raise NotImplementedError(f"{self.name} has no closed-form integral")
@@ -387,6 +392,13 @@ class StepEdge(Field):
 
     def gradient(self, points, *, h=None):
         return np.zeros(_points(points).shape)
+
+    def breakpoints(self, origins, directions):
+        o, d = _rays(origins, directions)
+        speed = d @ self.normal
+        with np.errstate(divide="ignore", invalid="ignore"):
+            cross = (self.offset - o @ self.normal) / speed
+        return np.where(speed != 0, cross, np.nan)[..., None]
 
     def line_integral(self, origins, directions, t0=-np.inf, t1=np.inf):
         o, d = _rays(origins, directions)

@@ -20,6 +20,8 @@ The public API is the list in ``__all__``.
 from vrlib import compositing, filters, metrics
 from vrlib.filters import FILTERS, make_filter
 from vrlib.image import Image, RenderStats
+from vrlib.reference import render_reference
+from vrlib.render import METHODS, render
 from vrlib.transfer import Glow, LookupTransfer, Phong, TransferFunction
 from vrlib.view import View
 from vrlib.volume import Volume
@@ -27,6 +29,9 @@ from vrlib.volume import Volume
 __version__ = "0.1.0"
 
 __all__ = [
+    "render",
+    "render_reference",
+    "METHODS",
     "Volume",
     "View",
     "Glow",

@@ -97,7 +97,10 @@ class TransferFunction:
         raise NotImplementedError
 
     def max_density(self, vmin, vmax):
-        """Largest opacity density for any value in ``[vmin, vmax]``: 0 means skippable."""
+        """Largest opacity density for any value in ``[vmin, vmax]``: 0 means skippable.
+
+        ``vmin`` and ``vmax`` may be arrays (one interval per entry).
+        """
         raise NotImplementedError
 
     @property
@@ -149,7 +152,8 @@ class Glow(TransferFunction):
         return np.ones(values.shape + (3,))
 
     def max_density(self, vmin, vmax):
-        return self.scale * max(float(vmax), 0.0)
+        out = self.scale * np.maximum(np.asarray(vmax, dtype=np.float64), 0.0)
+        return float(out) if out.ndim == 0 else out
 
     @property
     def code(self):
@@ -241,11 +245,31 @@ class LookupTransfer(TransferFunction):
         return np.stack([self._interp(self.color[:, c], values) for c in range(3)], axis=-1)
 
     def max_density(self, vmin, vmax):
-        lo, hi = self.value_range
-        grid = np.linspace(lo, hi, self.density.shape[0])
-        inside = self.density[(grid > vmin) & (grid < vmax)]
-        ends = self.opacity_density(np.array([vmin, vmax]))
-        return float(max(ends.max(), inside.max(initial=0.0)))
+        vmin, vmax = np.broadcast_arrays(np.asarray(vmin, float), np.asarray(vmax, float))
+        scalar = vmin.ndim == 0
+        vmin, vmax = np.atleast_1d(vmin), np.atleast_1d(vmax)
+        # The interpolated function peaks at an end of the interval or at a table entry
+        # strictly inside it; the entries' maximum comes from a sparse table (range maximum).
+        best = np.maximum(self.opacity_density(vmin), self.opacity_density(vmax))
+        grid = np.linspace(*self.value_range, self.density.shape[0])
+        first = np.searchsorted(grid, vmin, side="right")
+        last = np.searchsorted(grid, vmax, side="left")  # entries first .. last - 1
+        has = last > first
+        if np.any(has):
+            table = [self.density]  # table[lev][i] = max(density[i : i + 2**lev])
+            span = 1
+            while 2 * span <= self.density.shape[0]:
+                table.append(np.maximum(table[-1][:-span], table[-1][span:]))
+                span *= 2
+            f, n = first[has], last[has] - first[has]
+            level = np.floor(np.log2(n)).astype(int)
+            peak = np.empty(f.shape)
+            for lev in np.unique(level):
+                sel = level == lev
+                span = 1 << lev
+                peak[sel] = np.maximum(table[lev][f[sel]], table[lev][f[sel] + n[sel] - span])
+            best[has] = np.maximum(best[has], peak)
+        return float(best[0]) if scalar else best
 
     @property
     def code(self):

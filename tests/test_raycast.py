@@ -1,0 +1,241 @@
+"""Ray casting: agreement with the naive twin, determinism, skips, accuracy, bad input."""
+
+import math
+
+import numba
+import numpy as np
+import pytest
+from naive import raycast_naive
+
+import data_gen
+import vrlib
+from vrlib import Glow, LookupTransfer, Phong, View, Volume, metrics, render, render_reference
+from vrlib._kernels import raycast as kernel
+from vrlib.reference import _clip_to_box
+
+FILTERS = ["box", "trilinear", "catmull-rom", "bspline", "mitchell", "gaussian",
+           ("mitchell-netravali", 0.2, 0.6), ("gaussian", 0.5, 1.5)]
+TABLE = LookupTransfer([0.0, 3.0, 1.0, 5.0], [[1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 1]])
+
+
+def small_volume():
+    return data_gen.make_field("random-blobs", count=4, seed=2).sample((9, 11, 10))
+
+
+def exact_blob_image(field, view, scale):
+    """Brief section 2: 1 - exp(-k * line integral), clipped to the volume's box."""
+    o, d = view.rays()
+    t0, t1 = _clip_to_box(o, d, field.bounds[:, 0], field.bounds[:, 1])
+    return 1.0 - np.exp(-scale * field.line_integral(o, d, t0, t1))
+
+
+@pytest.mark.parametrize("projection", ["orthographic", "perspective"])
+@pytest.mark.parametrize("filt", FILTERS, ids=str)
+@pytest.mark.parametrize("transfer", [Glow(3.0), TABLE, Glow(2.0, shading=Phong(specular=0.4)),
+                                      LookupTransfer([0.0, 2.0], shading=Phong(light=(1, 2, 3)))],
+                         ids=["glow", "table", "glow-shaded", "table-shaded"])
+def test_kernel_matches_naive_twin(projection, filt, transfer):
+    """The optimised kernel (unrolled filters, tiles, threads) equals the by-the-book twin."""
+    vol = small_volume()
+    view = View.orbit(azimuth=33, elevation=-21, size=(7, 9), projection=projection)
+    fast = render(vol, view, filter=filt, transfer=transfer, step=0.37, early_termination=1.0)
+    slow = raycast_naive(vol, view, vrlib.make_filter(filt), transfer, 0.37)
+    np.testing.assert_allclose(fast.rgba, slow, atol=1e-6)
+    assert fast.alpha.max() > 0.1
+
+
+@pytest.mark.parametrize("filt", ["trilinear", "catmull-rom", "gaussian"])
+def test_bit_identical_for_one_and_two_threads(filt):
+    if numba.config.NUMBA_NUM_THREADS < 2:
+        pytest.skip("numba sees a single CPU: nothing to compare")
+    vol = data_gen.make_field("marschner-lobb").sample(24)
+    view = View.orbit(azimuth=20, elevation=35, size=70)
+    one = render(vol, view, filter=filt, threads=1)
+    two = render(vol, view, filter=filt, threads=2)
+    assert np.array_equal(one.rgba, two.rgba)
+    assert one.stats.samples == two.stats.samples
+
+
+@pytest.mark.parametrize("filt", ["box", "trilinear", "catmull-rom", "gaussian"])
+@pytest.mark.parametrize("transfer", [Glow(5.0), TABLE], ids=["glow", "table"])
+def test_empty_space_skipping_changes_nothing(filt, transfer):
+    """Skipping is exact: bit-identical images, and fewer samples on a sparse scene."""
+    field = data_gen.make_field("random-blobs", count=3, seed=5, sigma=(0.04, 0.06))
+    data = field.sample(48).data.copy()
+    data[data < 1e-3] = 0.0  # true empty space around the blobs
+    vol = Volume(data)
+    for azimuth, elevation in [(0, 0), (90, 0), (0, 90), (37, 23), (45, 45)]:
+        view = View.orbit(azimuth=azimuth, elevation=elevation, size=40)
+        skipped = render(vol, view, filter=filt, transfer=transfer)
+        full = render(vol, view, filter=filt, transfer=transfer, empty_space_skipping=False)
+        assert np.array_equal(skipped.rgba, full.rgba)
+        assert skipped.stats.samples < 0.5 * full.stats.samples
+
+
+def test_early_termination_stays_within_its_bound():
+    """Stopping at opacity 1 - e changes no channel by more than e (emission <= 1)."""
+    vol = data_gen.make_field("smooth-sphere", radius=0.7).sample(32)
+    view = View.orbit(azimuth=10, elevation=10, size=48)
+    full = render(vol, view, transfer=Glow(20.0), early_termination=1.0)
+    assert full.alpha.max() > 0.999
+    for threshold in [0.9, 0.99, 0.999]:
+        early = render(vol, view, transfer=Glow(20.0), early_termination=threshold)
+        assert np.abs(early.rgba - full.rgba).max() <= 1.0 - threshold + 1e-12
+        assert early.stats.samples < full.stats.samples
+
+
+def test_bricks_share_the_global_lattice():
+    """Two bricks (with ghost samples), each rendered over its own box and composited with
+    the over operator, give the whole volume's image: no sample is taken twice or missed."""
+    vol = data_gen.make_field("marschner-lobb").sample((20, 21, 22))
+    view = View.orbit(azimuth=-70, elevation=25, size=30)
+    whole = render(vol, view, filter="catmull-rom", step=0.41, early_termination=1.0,
+                   empty_space_skipping=False)
+    origins, directions = view.rays()
+    split, ghost = 10, 2
+    ext, spacing = vol.extent, vol.spacing
+    z_cut = ext[2, 0] + split * spacing[2]
+    parts = []
+    for lo_k, hi_k, box_z in [(0, split + ghost + 1, (ext[2, 0], z_cut)),
+                              (split - ghost, vol.shape[0], (z_cut, ext[2, 1]))]:
+        brick = np.ascontiguousarray(vol.data[lo_k:hi_k])
+        box_lo = np.array([ext[0, 0], ext[1, 0], box_z[0]])
+        box_hi = np.array([ext[0, 1], ext[1, 1], box_z[1]])
+        out = np.empty(view.shape + (4,))
+        tiles = math.ceil(view.height / 32) * math.ceil(view.width / 32)
+        code = vrlib.make_filter("catmull-rom").code
+        kernel.raycast(brick, np.array([lo_k, 0, 0]), np.array(vol.shape), ext[:, 0].copy(),
+                       spacing, box_lo, box_hi, origins, directions, 0.41 * spacing.min(),
+                       *code, 2.0, 4, *Glow(1.0).code, False, 0.0, 0.0, 0.0, 1.0,
+                       np.zeros(3), True, 1.0, np.zeros((1, 1, 1), bool), 0, 32,
+                       np.arange(tiles), out, np.zeros(tiles, np.int64))
+        parts.append(out)
+    # The view looks down (elevation 25): the upper brick (larger z) is in front.
+    composited = vrlib.compositing.over(parts[1], parts[0])
+    np.testing.assert_allclose(composited, whole.rgba, atol=1e-14)
+
+
+@pytest.mark.parametrize("filt", ["box", "trilinear", "catmull-rom", "bspline", "mitchell",
+                                  "gaussian"])
+def test_glow_blob_against_closed_form(filt):
+    """A Gaussian blob sampled at 64^3 against its closed-form image (brief section 2).
+
+    Measured rmse at steps 1, 0.5, 0.25 (64^3, 96^2, Glow(2), sigma 0.3, azimuth 30,
+    elevation 20): box 2.0e-4 / 9.3e-5 / 8.4e-5, trilinear 9.2e-5 at every step, Catmull-Rom
+    9.3e-6 / 4.8e-6 / 2.5e-6, B-spline 1.8e-4, Mitchell 6.1e-5, Gaussian 2.0e-4. The bound
+    asserted is the issue's (trilinear at step 0.5 under 2e-3) for every filter, and the
+    interpolating cubic must beat the tent.
+    """
+    field = data_gen.make_field("gaussian-blob", sigma=0.3, center=(0.05, -0.1, 0.08))
+    vol = field.sample(64)
+    view = View.orbit(azimuth=30, elevation=20, size=96)
+    exact = exact_blob_image(field, view, 2.0)
+    errors = [metrics.rmse(render(vol, view, filter=filt, transfer=Glow(2.0), step=s).alpha,
+                           exact) for s in (1.0, 0.5, 0.25)]
+    assert errors[1] < 2e-3
+    if filt == "catmull-rom":
+        tent = metrics.rmse(render(vol, view, transfer=Glow(2.0)).alpha, exact)
+        assert errors[1] < tent / 5
+        assert errors[2] < errors[1] < errors[0]  # converges as the step shrinks
+
+
+def test_mass_invariant_over_random_orbits():
+    """Sum of -ln(1 - alpha) * pixel area = k * integral of F (brief section 2), to 0.5%, for
+    8 random orbits, orthographic."""
+    field = data_gen.make_field("gaussian-blob", sigma=0.25, center=(0.1, 0.0, -0.1))
+    vol = field.sample(48)
+    k = 1.5
+    expected = k * field.integral(field.bounds)
+    rng = np.random.default_rng(11)
+    for azimuth, elevation in zip(rng.uniform(-180, 180, 8), rng.uniform(-90, 90, 8),
+                                  strict=True):
+        view = View.orbit(azimuth=azimuth, elevation=elevation, size=96)
+        img = render(vol, view, transfer=Glow(k))
+        mass = -np.log1p(-img.alpha).sum() * view.pixel_size**2
+        assert mass == pytest.approx(expected, rel=5e-3)
+
+
+@pytest.mark.parametrize("azimuth, elevation", [(0, 30), (30, 60), (45, 10)])
+def test_catmull_rom_beats_trilinear_on_marschner_lobb(azimuth, elevation):
+    """On Marschner-Lobb sampled at 41^3 (just under Nyquist), against the reference.
+
+    Measured rmse (64^2, Glow(2), step 0.25), trilinear / Catmull-Rom: 3.6e-3 / 3.2e-3 at
+    (0, 30), 5.4e-3 / 4.0e-3 at (30, 60), 7.6e-3 / 4.5e-3 at (45, 10): the cubic wins by 11% to
+    41% depending on the view (the projection along rays averages errors out most when the
+    rings are seen from above). The B-spline, which blurs, loses to trilinear everywhere.
+    """
+    field = data_gen.make_field("marschner-lobb")
+    vol = field.sample(41)
+    view = View.orbit(azimuth=azimuth, elevation=elevation, size=64)
+    ref = render_reference(field, view, transfer=Glow(2.0), tol=1e-6)
+
+    def error(filt):
+        return metrics.rmse(render(vol, view, filter=filt, transfer=Glow(2.0), step=0.25).alpha,
+                            ref.alpha)
+
+    tent, cubic, bspline = error("trilinear"), error("catmull-rom"), error("bspline")
+    assert cubic < 0.95 * tent
+    assert bspline > tent
+
+
+def test_images_converge_as_the_step_shrinks():
+    vol = data_gen.make_field("marschner-lobb").sample(24)
+    view = View.orbit(azimuth=15, elevation=40, size=32)
+    images = [render(vol, view, step=s, transfer=Glow(3.0)).rgba for s in (2.0, 1.0, 0.5, 0.25,
+                                                                          0.125)]
+    diffs = [np.abs(a - b).max() for a, b in zip(images, images[1:], strict=False)]
+    assert all(later < earlier for earlier, later in zip(diffs, diffs[1:], strict=False))
+
+
+def test_views_that_miss_give_a_transparent_image():
+    vol = small_volume()
+    off = View.orbit(size=8, center=(10, 10, 10), radius=0.5)
+    img = render(vol, off)
+    assert np.array_equal(img.rgba, np.zeros((8, 8, 4)))
+    assert img.stats.samples == 0
+
+
+def test_perspective_eye_inside_the_volume():
+    vol = data_gen.make_field("marschner-lobb").sample(16)
+    view = View.orbit(size=16, projection="perspective", distance=0.3, fov=60)
+    img = render(vol, view)
+    assert np.all(np.isfinite(img.rgba)) and img.alpha.max() > 0
+
+
+def test_stats_are_counted():
+    vol = small_volume()
+    img = render(vol, View.orbit(size=8), step=0.5)
+    assert img.stats.samples > 0
+    assert img.stats.operations > img.stats.samples
+    assert img.stats.bytes >= vol.data.nbytes
+    assert img.stats.seconds > 0
+
+
+@pytest.mark.parametrize(
+    "kwargs, error, message",
+    [
+        ({"method": "raytrace"}, ValueError, "unknown method 'raytrace'; known: 'raycast'"),
+        ({"filter": "cubic"}, ValueError, "unknown filter 'cubic'; known:"),
+        ({"filter": ("gaussian", 0.6, 5.0)}, ValueError, "ray casting takes at most 8"),
+        ({"step": 0.0}, ValueError, "step must be > 0"),
+        ({"step": -1.0}, ValueError, "step must be > 0"),
+        ({"step": math.nan}, ValueError, "step must be finite"),
+        ({"step": "fine"}, TypeError, "step must be a real number"),
+        ({"early_termination": 0.0}, ValueError, "early_termination must be > 0"),
+        ({"early_termination": 1.5}, ValueError, "early_termination must be <= 1"),
+        ({"transfer": "glow"}, TypeError, "transfer must be a vrlib transfer function"),
+        ({"empty_space_skipping": 1}, TypeError, "empty_space_skipping must be True or False"),
+        ({"threads": 0}, ValueError, "threads must be between 1 and"),
+        ({"threads": 1.5}, TypeError, "threads must be an integer"),
+    ],
+)
+def test_bad_input(kwargs, error, message):
+    with pytest.raises(error, match=message):
+        render(small_volume(), View.orbit(size=4), **kwargs)
+
+
+def test_bad_volume_or_view():
+    with pytest.raises(TypeError, match="volume must be a vrlib.Volume, got ndarray"):
+        render(np.zeros((4, 4, 4)), View.orbit(size=4))
+    with pytest.raises(TypeError, match="view must be a vrlib.View"):
+        render(small_volume(), (30, 20))

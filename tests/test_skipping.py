@@ -1,0 +1,62 @@
+"""Empty-space skipping: the emptiness test is conservative for every filter."""
+
+import numpy as np
+import pytest
+from naive import reconstruct_naive
+
+from vrlib import Glow, LookupTransfer, Volume, make_filter
+from vrlib.skipping import empty_blocks, filter_margin, lattice_sums
+
+
+def test_lattice_sums_of_known_filters():
+    """Partition-of-unity filters sum to 1; only filters with negative lobes have sum |w| > 1;
+    Catmull-Rom's 1-D sum |w| peaks at 1.25 (at half a sample: two lobes of -1/16)."""
+    for name in ["box", "trilinear", "bspline"]:
+        s_min, s_max, a_max = lattice_sums(make_filter(name))
+        assert s_min == pytest.approx(1.0) and s_max == pytest.approx(1.0)
+        assert a_max == pytest.approx(1.0)
+    s_min, s_max, a_max = lattice_sums(make_filter("catmull-rom"))
+    assert a_max == pytest.approx(1.25**3, rel=1e-6)
+    g_min, g_max, g_abs = lattice_sums(make_filter("gaussian", sigma=0.5))
+    assert g_min < 1.0 < g_max and g_abs == pytest.approx(g_max)
+
+
+def test_filter_margin():
+    margins = [filter_margin(make_filter(f)) for f in ["box", "trilinear", "catmull-rom"]]
+    assert margins == [0, 0, 1]
+    assert filter_margin(make_filter("gaussian", sigma=0.5, radius=2.5)) == 2
+
+
+@pytest.mark.parametrize("filt", ["box", "trilinear", "catmull-rom", "mitchell", "gaussian",
+                                  ("gaussian", 0.5, 2.5)], ids=str)
+@pytest.mark.parametrize("transfer", [Glow(1.0), LookupTransfer([0.0, 0.0, 1.0],
+                                                                value_range=(-1.0, 1.0))],
+                         ids=["glow", "table-from-0"])
+def test_empty_blocks_are_really_empty(filt, transfer):
+    """At random points inside every block marked empty, the reconstruction has zero
+    density; overshoot of the cubics near a bright voxel keeps neighbouring blocks marked."""
+    rng = np.random.default_rng(0)
+    data = np.zeros((17, 17, 17))
+    data[rng.integers(0, 17, 6), rng.integers(0, 17, 6), rng.integers(0, 17, 6)] = 1.0
+    data[8, 8, 8] = -0.5  # a negative voxel: cubic overshoot around it must not fool the test
+    vol = Volume(data)
+    f = make_filter(filt)
+    empty = empty_blocks(vol, f, transfer, block=4)
+    assert 0 < empty.sum() < empty.size
+    for idx in np.argwhere(empty):
+        pts = (idx[::-1] + rng.uniform(0, 1, (20, 3))) * 4  # index coords inside the block
+        values = reconstruct_naive(vol, f, np.minimum(pts, 16))
+        assert np.all(transfer.opacity_density(values) == 0.0)
+
+
+def test_vectorised_max_density_matches_scalar():
+    rng = np.random.default_rng(4)
+    tf = LookupTransfer(rng.uniform(0, 3, 37) * (rng.uniform(0, 1, 37) > 0.5),
+                        value_range=(-1.0, 2.0))
+    lo = rng.uniform(-2, 3, 500)
+    hi = lo + rng.exponential(0.3, 500)
+    many = tf.max_density(lo, hi)
+    one = np.array([tf.max_density(a, b) for a, b in zip(lo, hi, strict=True)])
+    np.testing.assert_array_equal(many, one)
+    for a, b, m in zip(lo[:50], hi[:50], many[:50], strict=True):
+        assert m == pytest.approx(tf.opacity_density(np.linspace(a, b, 20001)).max(), abs=1e-3)

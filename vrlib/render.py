@@ -1,0 +1,106 @@
+"""``render``: one entry point that validates its arguments and dispatches to a renderer."""
+
+from __future__ import annotations
+
+import contextlib
+import numbers
+
+import numba
+
+from vrlib import _validate
+from vrlib.filters import make_filter
+from vrlib.raycast import render_raycast
+from vrlib.transfer import Glow, TransferFunction
+from vrlib.view import View
+from vrlib.volume import Volume
+
+__all__ = ["render", "METHODS"]
+
+#: Rendering methods by name.
+METHODS = {"raycast": render_raycast}
+
+
+@contextlib.contextmanager
+def _threads(count):
+    if count is None:
+        yield
+        return
+    previous = numba.get_num_threads()
+    numba.set_num_threads(count)
+    try:
+        yield
+    finally:
+        numba.set_num_threads(previous)
+
+
+def render(volume, view, *, method="raycast", filter="trilinear", transfer=None, step=0.5,
+           early_termination=0.999, empty_space_skipping=True, threads=None):
+    """Render a volume into an image.
+
+    Parameters
+    ----------
+    volume : Volume
+    view : View
+    method : {"raycast"}
+        The rendering method (see :data:`METHODS`).
+    filter : str, tuple or Filter, default "trilinear"
+        Reconstruction filter, by name or built with :func:`vrlib.make_filter`.
+    transfer : TransferFunction, default ``Glow(1.0)``
+    step : float, default 0.5
+        Sample spacing along each ray, in voxels (of the smallest spacing); > 0. Opacity is
+        computed per segment as ``1 - exp(-density * step)``, so images converge as the step
+        shrinks.
+    early_termination : float, default 0.999
+        Stop a ray once its opacity reaches this value, in (0, 1]; 1 turns it off. The image
+        changes by at most ``1 - early_termination`` times the brightest emission.
+    empty_space_skipping : bool, default True
+        Jump over blocks that the filter and transfer function make invisible; never changes
+        the image.
+    threads : int, optional
+        Threads to use (default: numba's setting). The image does not depend on it.
+
+    Returns
+    -------
+    Image
+
+    Raises
+    ------
+    TypeError, ValueError
+        Arguments of the wrong kind or out of range; the message names the parameter.
+
+    Examples
+    --------
+    >>> import data_gen, vrlib
+    >>> vol = data_gen.make_field("gaussian-blob", sigma=0.3).sample(16)
+    >>> img = vrlib.render(vol, vrlib.View.orbit(size=8), filter="catmull-rom")
+    >>> img.shape, bool(0.0 < img.alpha.max() < 1.0)
+    ((8, 8), True)
+    """
+    if not isinstance(volume, Volume):
+        raise TypeError(f"volume must be a vrlib.Volume, got {type(volume).__name__}")
+    if not isinstance(view, View):
+        raise TypeError(f"view must be a vrlib.View, got {type(view).__name__}")
+    _validate.choice("method", method, tuple(METHODS))
+    filt = make_filter(filter)
+    transfer = Glow(1.0) if transfer is None else transfer
+    if not isinstance(transfer, TransferFunction):
+        raise TypeError(
+            f"transfer must be a vrlib transfer function (Glow, LookupTransfer), got {transfer!r}"
+        )
+    step = _validate.positive_number("step", step)
+    early_termination = _validate.finite_number("early_termination", early_termination,
+                                                low=0.0, high=1.0, low_open=True)
+    if not isinstance(empty_space_skipping, bool):
+        raise TypeError(
+            f"empty_space_skipping must be True or False, got {empty_space_skipping!r}"
+        )
+    if threads is not None:
+        if isinstance(threads, bool) or not isinstance(threads, numbers.Integral):
+            raise TypeError(f"threads must be an integer, got {threads!r}")
+        limit = numba.config.NUMBA_NUM_THREADS
+        if not 1 <= threads <= limit:
+            raise ValueError(f"threads must be between 1 and {limit}, got {threads}")
+    with _threads(threads):
+        return METHODS[method](volume, view, filt=filt, transfer=transfer, step=step,
+                               early_termination=early_termination,
+                               empty_space_skipping=empty_space_skipping)
