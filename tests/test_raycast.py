@@ -10,7 +10,7 @@ from naive import raycast_naive
 import data_gen
 import vrlib
 from vrlib import Glow, LookupTransfer, Phong, View, Volume, metrics, render, render_reference
-from vrlib._kernels import raycast as kernel
+from vrlib.raycast import cast_rays, reconstructed_range
 from vrlib.reference import _clip_to_box
 
 FILTERS = ["box", "trilinear", "catmull-rom", "bspline", "mitchell", "gaussian",
@@ -64,8 +64,12 @@ def test_empty_space_skipping_changes_nothing(filt, transfer):
     data = field.sample(48).data.copy()
     data[data < 1e-3] = 0.0  # true empty space around the blobs
     vol = Volume(data)
-    for azimuth, elevation in [(0, 0), (90, 0), (0, 90), (37, 23), (45, 45)]:
-        view = View.orbit(azimuth=azimuth, elevation=elevation, size=40)
+    views = [View.orbit(azimuth=a, elevation=e, size=40)
+             for a, e in [(0, 0), (90, 0), (0, 90), (37, 23), (45, 45)]]
+    views += [View.orbit(azimuth=-50, elevation=15, size=40, projection="perspective"),
+              View.orbit(azimuth=10, elevation=5, size=40, projection="perspective",
+                         distance=0.5, fov=70)]  # eye inside: blocks behind it
+    for view in views:
         skipped = render(vol, view, filter=filt, transfer=transfer)
         full = render(vol, view, filter=filt, transfer=transfer, empty_space_skipping=False)
         assert np.array_equal(skipped.rgba, full.rgba)
@@ -89,27 +93,22 @@ def test_bricks_share_the_global_lattice():
     the over operator, give the whole volume's image: no sample is taken twice or missed."""
     vol = data_gen.make_field("marschner-lobb").sample((20, 21, 22))
     view = View.orbit(azimuth=-70, elevation=25, size=30)
-    whole = render(vol, view, filter="catmull-rom", step=0.41, early_termination=1.0,
+    filt = vrlib.make_filter("catmull-rom")
+    whole = render(vol, view, filter=filt, step=0.41, early_termination=1.0,
                    empty_space_skipping=False)
-    origins, directions = view.rays()
     split, ghost = 10, 2
-    ext, spacing = vol.extent, vol.spacing
-    z_cut = ext[2, 0] + split * spacing[2]
+    ext = vol.extent
+    z_cut = ext[2, 0] + split * vol.spacing[2]
     parts = []
-    for lo_k, hi_k, box_z in [(0, split + ghost + 1, (ext[2, 0], z_cut)),
-                              (split - ghost, vol.shape[0], (z_cut, ext[2, 1]))]:
-        brick = np.ascontiguousarray(vol.data[lo_k:hi_k])
-        box_lo = np.array([ext[0, 0], ext[1, 0], box_z[0]])
-        box_hi = np.array([ext[0, 1], ext[1, 1], box_z[1]])
-        out = np.empty(view.shape + (4,))
-        tiles = math.ceil(view.height / 32) * math.ceil(view.width / 32)
-        code = vrlib.make_filter("catmull-rom").code
-        kernel.raycast(brick, np.array([lo_k, 0, 0]), np.array(vol.shape), ext[:, 0].copy(),
-                       spacing, box_lo, box_hi, origins, directions, 0.41 * spacing.min(),
-                       *code, 2.0, 4, *Glow(1.0).code, False, 0.0, 0.0, 0.0, 1.0,
-                       np.zeros(3), True, 1.0, np.zeros((1, 1, 1), bool), 0, 32,
-                       np.arange(tiles), out, np.zeros(tiles, np.int64))
-        parts.append(out)
+    for first, stop, (z_lo, z_hi) in [(0, split + ghost + 1, (ext[2, 0], z_cut)),
+                                      (split - ghost, vol.shape[0], (z_cut, ext[2, 1]))]:
+        rgba, _ = cast_rays(
+            np.ascontiguousarray(vol.data[first:stop]), offset=(first, 0, 0),
+            global_shape=vol.shape, origin=vol.origin, spacing=vol.spacing,
+            box=([ext[0, 0], ext[1, 0], z_lo], [ext[0, 1], ext[1, 1], z_hi]), view=view,
+            filt=filt, transfer=Glow(1.0), ds=0.41 * vol.spacing.min(),
+            value_range=reconstructed_range(vol, filt), early_termination=1.0)
+        parts.append(rgba)
     # The view looks down (elevation 25): the upper brick (larger z) is in front.
     composited = vrlib.compositing.over(parts[1], parts[0])
     np.testing.assert_allclose(composited, whole.rgba, atol=1e-14)

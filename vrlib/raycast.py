@@ -18,14 +18,14 @@ import numpy as np
 from vrlib._kernels import raycast as _kernel
 from vrlib._kernels.sampling import MAX_TAPS
 from vrlib.image import Image, RenderStats
-from vrlib.skipping import empty_blocks
+from vrlib.skipping import empty_blocks, lattice_sums
 
 __all__ = ["render_raycast", "operations_per_sample", "BLOCK"]
 
 #: Cells per block (each axis) of the empty-space skipping grid.
 BLOCK = 8
-#: Pixels per side of the image tiles that the parallel loop hands out.
-TILE = 32
+#: Pixels (rows, columns) of the image tiles that the parallel loop hands out.
+TILE = (32, 32)
 
 
 def taps_per_axis(filt):
@@ -61,6 +61,63 @@ def _kernel_tent():
     return TENT
 
 
+def reconstructed_range(volume, filt):
+    """Bounds on every value the filter can reconstruct from this volume (overshoot of
+    negative lobes and the Gaussian's ripple included; see :mod:`vrlib.skipping`)."""
+    s_min, s_max, a_max = lattice_sums(filt)
+    lo, hi = volume.value_range
+    centre, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
+    return (min(centre * s_min, centre * s_max) - a_max * half,
+            max(centre * s_min, centre * s_max) + a_max * half)
+
+
+def coarsen(empty, factor=4):
+    """Blocks of ``factor^3`` blocks that are all empty (edge blocks padded as empty)."""
+    pad = [(0, -n % factor) for n in empty.shape]
+    padded = np.pad(empty, pad, constant_values=True)
+    shape = []
+    for n in padded.shape:
+        shape += [n // factor, factor]
+    return padded.reshape(shape).all(axis=(1, 3, 5))
+
+
+def visible_box(volume, empty, block, lo, hi):
+    """World box around every non-empty block (a sliver larger, so that samples on its faces
+    are taken whatever the rounding), clipped to ``[lo, hi]``; empty if nothing is visible."""
+    full = np.argwhere(~empty)
+    if full.size == 0:
+        return lo, lo.copy()  # t_out <= t_in for every ray
+    first = full.min(axis=0)[::-1] * block  # cells, x y z
+    last = (full.max(axis=0)[::-1] + 1) * block
+    sliver = 1e-9 * (hi - lo)
+    box_lo = np.maximum(volume.origin + first * volume.spacing - sliver, lo)
+    box_hi = np.minimum(volume.origin + last * volume.spacing + sliver, hi)
+    return box_lo, box_hi
+
+
+def footprint_mask(view, volume, empty, block):
+    """Pixels whose rays can meet a non-empty block: the union of the blocks' projected
+    bounding rectangles, one pixel wider all round (exact when conservative: a ray outside it
+    crosses only empty blocks, whose samples add nothing)."""
+    full = np.argwhere(~empty)[:, ::-1]  # block indices, x y z
+    corners = np.array(np.meshgrid([0, 1], [0, 1], [0, 1], indexing="ij")).reshape(3, -1).T
+    cells = (full[:, None, :] + corners[None, :, :]) * block
+    cells = np.minimum(cells, np.array(volume.shape[::-1]) - 1)
+    projected = view.project(volume.origin + cells * volume.spacing)  # (blocks, 8, 3)
+    if not np.all(np.isfinite(projected)) or np.any(projected[..., 2] <= 0.0):
+        return np.ones(view.shape, dtype=bool)  # a block reaches behind the eye: keep all
+    r0 = np.clip(np.floor(projected[..., 0].min(axis=1)).astype(int) - 1, 0, view.height)
+    r1 = np.clip(np.floor(projected[..., 0].max(axis=1)).astype(int) + 2, 0, view.height)
+    c0 = np.clip(np.floor(projected[..., 1].min(axis=1)).astype(int) - 1, 0, view.width)
+    c1 = np.clip(np.floor(projected[..., 1].max(axis=1)).astype(int) + 2, 0, view.width)
+    marks = np.zeros((view.height + 1, view.width + 1), dtype=np.int64)
+    np.add.at(marks, (r0, c0), 1)
+    np.add.at(marks, (r0, c1), -1)
+    np.add.at(marks, (r1, c0), -1)
+    np.add.at(marks, (r1, c1), 1)
+    return marks.cumsum(axis=0).cumsum(axis=1)[:-1, :-1] > 0
+
+
 def spread_order(n):
     """The tiles ``0 .. n-1`` in an order that spreads neighbours apart (a coprime stride), so
     that a parallel loop's equal chunks hold equal shares of every part of the image.
@@ -79,49 +136,82 @@ def spread_order(n):
 def render_raycast(volume, view, *, filt, transfer, step, early_termination,
                    empty_space_skipping):
     """Ray-cast ``volume`` (arguments already validated by :func:`vrlib.render`)."""
+    extent = volume.extent
+    box_lo, box_hi = extent[:, 0].copy(), extent[:, 1].copy()
+    skip = None
+    if empty_space_skipping:
+        empty = empty_blocks(volume, filt, transfer, block=BLOCK)
+        if empty.any():  # with nothing to skip, checking would only cost time
+            box_lo, box_hi = visible_box(volume, empty, BLOCK, box_lo, box_hi)
+            skip = (empty, coarsen(empty), BLOCK, footprint_mask(view, volume, empty, BLOCK))
+    start = time.perf_counter()
+    rgba, taken = cast_rays(
+        volume.data, offset=(0, 0, 0), global_shape=volume.shape, origin=volume.origin,
+        spacing=volume.spacing, box=(box_lo, box_hi), view=view, filt=filt, transfer=transfer,
+        ds=step * float(volume.spacing.min()), value_range=reconstructed_range(volume, filt),
+        early_termination=early_termination, skip=skip,
+    )
+    stats = RenderStats(
+        samples=taken,
+        operations=taken * operations_per_sample(filt, shading=transfer.shading is not None),
+        bytes=int(volume.data.nbytes + rgba.nbytes + 2 * view.height * view.width * 3 * 8),
+        seconds=time.perf_counter() - start,
+    )
+    return Image(rgba, stats)
+
+
+def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, transfer, ds,
+              value_range, early_termination, skip=None):
+    """Ray-cast samples ``data`` (all of a volume, or a brick of it with ghost samples).
+
+    Parameters
+    ----------
+    data : ndarray (nz, ny, nx)
+        Samples from global index ``offset`` (z, y, x) on, of a volume of ``global_shape``
+        whose first sample lies at world ``origin`` with ``spacing`` (x, y, z).
+    box : (ndarray, ndarray)
+        World box whose samples these rays take (a brick's own region, without ghosts).
+    ds : float
+        Sample spacing along rays, world units.
+    value_range : (float, float)
+        Bounds on reconstructed values (for the classification table).
+    skip : (empty, coarse, block, mask) or None
+        Empty-space skipping grids (global blocks) and the pixels whose rays can meet a
+        non-empty block, or None to sample everywhere.
+
+    Returns
+    -------
+    rgba : ndarray (height, width, 4)
+    samples : int
+        Samples reconstructed.
+    """
     ntaps = taps_per_axis(filt)
     if ntaps > MAX_TAPS:
         raise ValueError(
             f"filter radius {filt.radius:g} needs {ntaps} taps per axis; ray casting takes at "
             f"most {MAX_TAPS} (radius <= {MAX_TAPS // 2})"
         )
-    ds = step * float(volume.spacing.min())
     origins, directions = view.rays()
-    fkind, fp0, fp1, fp2 = filt.code
-    tkind, tscale, tvmin, tvmax, dtab, ctab = transfer.code
+    tables = transfer.segment_table(ds, *value_range)
     shading = transfer.shading
     if shading is None:
-        shade, ka, kd, ks, shininess, light, headlight = False, 0.0, 0.0, 0.0, 1.0, None, True
+        lighting = (False, 0.0, 0.0, 0.0, 1.0, np.zeros(3), True)
     else:
-        shade, ka, kd, ks, shininess = (True, shading.ambient, shading.diffuse,
-                                        shading.specular, shading.shininess)
-        light, headlight = shading.light, shading.light is None
-    light = np.zeros(3) if light is None else np.asarray(light, dtype=np.float64)
-    if empty_space_skipping:
-        empty, block = empty_blocks(volume, filt, transfer, block=BLOCK), BLOCK
-    else:
-        empty, block = np.zeros((1, 1, 1), dtype=bool), 0
-    extent = volume.extent
+        light = np.zeros(3) if shading.light is None else np.asarray(shading.light, float)
+        lighting = (True, shading.ambient, shading.diffuse, shading.specular,
+                    shading.shininess, light, shading.light is None)
+    if skip is None:
+        skip = (np.zeros((1, 1, 1), dtype=bool), np.zeros((1, 1, 1), dtype=bool), 0,
+                np.ones(view.shape, dtype=bool))
     out = np.empty(view.shape + (4,))
-    tiles = -(-view.height // TILE) * -(-view.width // TILE)
+    tiles = -(-view.height // TILE[0]) * -(-view.width // TILE[1])
     samples = np.zeros(tiles, dtype=np.int64)
-    start = time.perf_counter()
     _kernel.raycast(
-        volume.data, np.zeros(3, np.int64), np.array(volume.shape, np.int64),
-        np.ascontiguousarray(extent[:, 0]), volume.spacing, np.ascontiguousarray(extent[:, 0]),
-        np.ascontiguousarray(extent[:, 1]), origins, directions, ds,
-        fkind, fp0, fp1, fp2, filt.radius, ntaps,
-        tkind, tscale, tvmin, tvmax, dtab, ctab,
-        shade, ka, kd, ks, shininess, light, headlight,
-        early_termination, empty, block, TILE, spread_order(tiles), out, samples,
-    )
-    seconds = time.perf_counter() - start
-    taken = int(samples.sum())
-    stats = RenderStats(
-        samples=taken,
-        operations=taken * operations_per_sample(filt, shading=shade),
-        bytes=int(volume.data.nbytes + out.nbytes + origins.nbytes + directions.nbytes),
-        seconds=seconds,
+        data, np.asarray(offset, np.int64), np.asarray(global_shape, np.int64),
+        np.asarray(origin, np.float64), np.asarray(spacing, np.float64),
+        np.asarray(box[0], np.float64), np.asarray(box[1], np.float64), origins, directions,
+        ds, *filt.code, filt.radius, ntaps, *tables, *lighting, early_termination, *skip, *TILE,
+        spread_order(tiles), out, samples, shading is None and bool(np.all(tables[4] == 1.0)),
     )
     np.clip(out[..., 3], 0.0, 1.0, out=out[..., 3])
-    return Image(out, stats)
+    return out, int(samples.sum())

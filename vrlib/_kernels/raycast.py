@@ -5,6 +5,9 @@ from the ray's origin (the view's origin plane, or the eye), and stands for the 
 ``[k ds, (k + 1) ds)``. A volume split into bricks therefore takes exactly the same samples as
 the whole volume: a brick renders those of its samples with ``t`` in ``[t_in, t_out)`` of its
 own box, and no sample is taken twice or missed at a boundary.
+
+Classification reads a per-render table of segment opacity and colour
+(:meth:`vrlib.transfer.TransferFunction.segment_table`), linearly interpolated.
 """
 
 from __future__ import annotations
@@ -17,7 +20,6 @@ from numba import prange
 from vrlib._kernels._jit import jit, parallel_jit
 from vrlib._kernels.filters import CUBIC, TENT
 from vrlib._kernels.sampling import MAX_TAPS, gradient, reconstruct, tricubic, trilinear
-from vrlib._kernels.transfer import GLOW, density, emission
 
 
 @jit
@@ -41,59 +43,84 @@ def ray_box(o, d, lo, hi):
 
 
 @jit
-def _block_of(u, block, nblocks):
-    b = int(u) // block
+def _cell(u, cells, count):
+    """Block holding index position ``u`` on a grid of ``count`` blocks of ``cells`` cells."""
+    b = int(math.floor(u)) // cells
     if b < 0:
         return 0
-    if b > nblocks - 1:
-        return nblocks - 1
+    if b > count - 1:
+        return count - 1
     return b
 
 
 @jit
-def _in_empty_block(empty, block, ux, uy, uz):
-    return empty[_block_of(uz, block, empty.shape[0]), _block_of(uy, block, empty.shape[1]),
-                 _block_of(ux, block, empty.shape[2])]
+def _is_empty(empty, cells, ux, uy, uz):
+    return empty[_cell(uz, cells, empty.shape[0]), _cell(uy, cells, empty.shape[1]),
+                 _cell(ux, cells, empty.shape[2])]
 
 
 @jit
-def _block_exit(o, d, origin, spacing, block, ux, uy, uz, nb):
-    """Ray parameter at which the ray leaves the block holding index position (ux, uy, uz)."""
+def _exit(ax, ay, az, bx, by, bz, cells, counts, ux, uy, uz):
+    """Ray parameter where the ray (index position ``a + t b``) leaves the block that holds
+    ``(ux, uy, uz)`` on a grid of ``cells``-cell blocks (``counts`` blocks per axis, z y x)."""
     t_exit = math.inf
-    u = (ux, uy, uz)
-    for a in range(3):
-        if d[a] == 0.0:
-            continue
-        b = _block_of(u[a], block, nb[a])
-        edge = b + 1 if d[a] > 0.0 else b
-        bound = origin[a] + edge * block * spacing[a]
-        t_exit = min(t_exit, (bound - o[a]) / d[a])
+    for a, b, u, n in ((ax, bx, ux, counts[2]), (ay, by, uy, counts[1]),
+                       (az, bz, uz, counts[0])):
+        if b != 0.0:
+            block = _cell(u, cells, n)
+            edge = (block + 1) * cells if b > 0.0 else block * cells
+            t_exit = min(t_exit, (edge - a) / b)
     return t_exit
+
+
+@jit
+def _lookup(x, n):
+    """Left table entry and weight for grid position ``x`` (clamped to the table)."""
+    if not x > 0.0:  # also catches NaN
+        return 0, 0.0
+    if x >= n - 1:
+        return n - 2, 1.0
+    i = int(x)
+    return i, x - i
 
 
 @parallel_jit
 def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, ray_o, ray_d, ds,
             fkind, fp0, fp1, fp2, radius, ntaps,
-            tkind, tscale, tvmin, tvmax, dtab, ctab,
+            tstart, tinv, alpha_tab, color_tab, emit_tab,
             shade, ka, kd, ks, shininess, light, headlight,
-            threshold, empty, block, tile, order, out, samples):
+            threshold, empty, coarse, block, mask, tile_h, tile_w, order, out, samples, grey):
     """Render ``out[row, col] = (r, g, b, a)`` premultiplied; count samples per tile.
 
-    The image is cut into ``tile x tile`` pixel tiles: neighbouring rays read neighbouring
-    voxels, so a tile keeps its voxels in cache. ``order`` lists the tiles in the order the
-    parallel loop takes them (spread over the image so that threads share the work evenly).
-    Each pixel is computed independently and in a fixed order, so the image does not depend on
-    the number of threads. ``block = 0`` turns empty-space skipping off; ``threshold = 1``
-    turns early ray termination off.
+    ``data`` holds the samples from global index ``offset`` on (the whole volume, or a brick
+    with ghost samples) of a volume of global shape ``gshape`` whose sample 0 is at world
+    ``origin``; rays sample the world box ``[box_lo, box_hi]``. The image is cut into
+    ``tile_h x tile_w`` pixel tiles, taken in the order ``order`` (spread over the image so that
+    threads share the work evenly); neighbouring rays read neighbouring voxels, so a tile keeps
+    them in cache. Each pixel is computed independently and in a fixed order: the image does
+    not depend on the number of threads.
+
+    Skips: ``empty`` flags blocks of ``block`` cells per axis that nothing visible can come
+    from, and ``coarse`` blocks of ``4 * block`` cells all of whose blocks are empty
+    (``block = 0`` turns skipping off), and ``mask`` the pixels whose rays can meet a
+    non-empty block; ``threshold = 1`` turns early ray termination off.
+    ``grey`` says the emission is 1 everywhere and unshaded, so colour equals opacity.
     """
     height, width = ray_o.shape[0], ray_o.shape[1]
-    tiles_across = (width + tile - 1) // tile
-    nb = np.array(empty.shape[::-1]) if block > 0 else np.ones(3, np.int64)
+    tiles_across = (width + tile_w - 1) // tile_w
+    flat = data.reshape(-1)
+    nx = data.shape[2]
+    nxy = data.shape[1] * data.shape[2]
+    oz, oy, ox = offset[0], offset[1], offset[2]
+    gz, gy, gx = gshape[0], gshape[1], gshape[2]
+    fine_counts = np.array(empty.shape)
+    coarse_counts = np.array(coarse.shape)
+    ntab = alpha_tab.shape[0]
     inv = 1.0 / spacing
     for it in prange(order.shape[0]):
         tile_id = order[it]
-        row0 = (tile_id // tiles_across) * tile
-        col0 = (tile_id % tiles_across) * tile
+        row0 = (tile_id // tiles_across) * tile_h
+        col0 = (tile_id % tiles_across) * tile_w
         wx = np.empty(MAX_TAPS)
         wy = np.empty(MAX_TAPS)
         wz = np.empty(MAX_TAPS)
@@ -101,9 +128,9 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, ray_o, ray_d,
         dy = np.empty(MAX_TAPS)
         dz = np.empty(MAX_TAPS)
         taken = 0
-        for p in range(tile * tile):
-            r = row0 + p // tile
-            c = col0 + p % tile
+        for p in range(tile_h * tile_w):
+            r = row0 + p // tile_w
+            c = col0 + p % tile_w
             if r >= height or c >= width:
                 continue
             o = ray_o[r, c]
@@ -112,6 +139,8 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, ray_o, ray_d,
             out[r, c, 1] = 0.0
             out[r, c, 2] = 0.0
             out[r, c, 3] = 0.0
+            if not mask[r, c]:
+                continue
             t_in, t_out = ray_box(o, d, box_lo, box_hi)
             t_in = max(t_in, 0.0)
             if not t_out > t_in:
@@ -128,6 +157,9 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, ray_o, ray_d,
             by = d[1] * inv[1]
             bz = d[2] * inv[2]
             k = math.ceil(t_in / ds - 0.5)
+            # Samples before t_check lie in a block already found not empty: no check needed
+            # (a sample that rounding puts in an empty block anyway adds exactly nothing).
+            t_check = -math.inf if block > 0 else math.inf
             while True:
                 t = (k + 0.5) * ds
                 if t >= t_out:
@@ -135,46 +167,50 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, ray_o, ray_d,
                 ux = ax + t * bx
                 uy = ay + t * by
                 uz = az + t * bz
-                if block > 0 and _in_empty_block(empty, block, ux, uy, uz):
-                    # Skip to the first sample past this block; step back over any sample that
-                    # rounding placed in a block that is not empty, so the image is unchanged.
-                    t_exit = _block_exit(o, d, origin, spacing, block, ux, uy, uz, nb)
+                if t >= t_check and not _is_empty(empty, block, ux, uy, uz):
+                    t_check = _exit(ax, ay, az, bx, by, bz, block, fine_counts, ux, uy, uz)
+                elif t >= t_check:
+                    # Jump past the largest empty block here, then step back over any sample
+                    # that rounding placed in a block that is not empty: the image is unchanged.
+                    if _is_empty(coarse, 4 * block, ux, uy, uz):
+                        t_exit = _exit(ax, ay, az, bx, by, bz, 4 * block, coarse_counts,
+                                       ux, uy, uz)
+                    else:
+                        t_exit = _exit(ax, ay, az, bx, by, bz, block, fine_counts, ux, uy, uz)
                     k_next = max(math.ceil(t_exit / ds - 0.5), k + 1)
                     while k_next > k + 1:
                         tb = (k_next - 0.5) * ds
-                        if _in_empty_block(empty, block, ax + tb * bx, ay + tb * by,
-                                           az + tb * bz):
+                        if _is_empty(empty, block, ax + tb * bx, ay + tb * by, az + tb * bz):
                             break
                         k_next -= 1
                     k = k_next
                     continue
                 # The two common filters unrolled, the others through the general loop.
                 if fkind == TENT:
-                    value = trilinear(data, offset, gshape, ux, uy, uz)
+                    value = trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz)
                 elif fkind == CUBIC:
-                    value = tricubic(data, offset, gshape, ux, uy, uz, fp0, fp1)
+                    value = tricubic(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz,
+                                     fp0, fp1)
                 else:
                     value = reconstruct(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1, fp2,
                                         radius, ntaps, wx, wy, wz)
                 taken += 1
                 k += 1
-                dens = density(tkind, tscale, tvmin, tvmax, dtab, value)
-                if not dens > 0.0:
+                # Classify: segment opacity 1 - exp(-density ds) (eq 1.4) and colour E alpha
+                # (eq 1.9), from the table.
+                i, w = _lookup((value - tstart) * tinv, ntab)
+                alpha = alpha_tab[i] + w * (alpha_tab[i + 1] - alpha_tab[i])
+                if not alpha > 0.0:
                     continue  # a transparent segment adds exactly nothing
-                alpha = -math.expm1(-dens * ds)  # eq 1.4
-                if tkind == GLOW:
-                    er = eg = eb = 1.0
-                else:
-                    er = emission(tkind, tvmin, tvmax, ctab, value, 0)
-                    eg = emission(tkind, tvmin, tvmax, ctab, value, 1)
-                    eb = emission(tkind, tvmin, tvmax, ctab, value, 2)
-                if shade:
-                    gx, gy, gz = gradient(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1,
-                                          fp2, radius, ntaps, wx, wy, wz, dx, dy, dz)
-                    gx *= inv[0]
-                    gy *= inv[1]
-                    gz *= inv[2]
-                    norm = math.sqrt(gx * gx + gy * gy + gz * gz)
+                if grey:
+                    cr = cg = cb = alpha  # white emission, no shading: colour = opacity
+                elif shade:
+                    gx_, gy_, gz_ = gradient(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1,
+                                             fp2, radius, ntaps, wx, wy, wz, dx, dy, dz)
+                    gx_ *= inv[0]
+                    gy_ *= inv[1]
+                    gz_ *= inv[2]
+                    norm = math.sqrt(gx_ * gx_ + gy_ * gy_ + gz_ * gz_)
                     if headlight:
                         lx, ly, lz = -d[0], -d[1], -d[2]
                     else:
@@ -187,22 +223,29 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, ray_o, ray_d,
                     else:
                         hx, hy, hz = lx, ly, lz
                     if norm > 0.0:
-                        ndotl = abs(gx * lx + gy * ly + gz * lz) / norm
-                        ndoth = abs(gx * hx + gy * hy + gz * hz) / norm
+                        ndotl = abs(gx_ * lx + gy_ * ly + gz_ * lz) / norm
+                        ndoth = abs(gx_ * hx + gy_ * hy + gz_ * hz) / norm
                     else:
                         ndotl = 1.0
                         ndoth = 1.0
                     factor = ka + kd * ndotl
                     spec = ks * ndoth**shininess
-                    er = er * factor + spec
-                    eg = eg * factor + spec
-                    eb = eb * factor + spec
-                # Front-to-back over, eqs 1.7-1.8, with premultiplied colour E * alpha (eq 1.9).
-                w = (1.0 - acc_a) * alpha
-                acc_r += w * er
-                acc_g += w * eg
-                acc_b += w * eb
-                acc_a += w
+                    er = emit_tab[i, 0] + w * (emit_tab[i + 1, 0] - emit_tab[i, 0])
+                    eg = emit_tab[i, 1] + w * (emit_tab[i + 1, 1] - emit_tab[i, 1])
+                    eb = emit_tab[i, 2] + w * (emit_tab[i + 1, 2] - emit_tab[i, 2])
+                    cr = (er * factor + spec) * alpha
+                    cg = (eg * factor + spec) * alpha
+                    cb = (eb * factor + spec) * alpha
+                else:
+                    cr = color_tab[i, 0] + w * (color_tab[i + 1, 0] - color_tab[i, 0])
+                    cg = color_tab[i, 1] + w * (color_tab[i + 1, 1] - color_tab[i, 1])
+                    cb = color_tab[i, 2] + w * (color_tab[i + 1, 2] - color_tab[i, 2])
+                # Front-to-back over, eqs 1.7-1.8.
+                remaining = 1.0 - acc_a
+                acc_r += remaining * cr
+                acc_g += remaining * cg
+                acc_b += remaining * cb
+                acc_a += remaining * alpha
                 if acc_a >= threshold:
                     break
             out[r, c, 0] = acc_r

@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 
 from vrlib._kernels._jit import jit
-from vrlib._kernels.filters import CUBIC, TENT, derivative, weight
+from vrlib._kernels.filters import derivative, weight
 
 #: Largest number of taps per axis (a filter radius of at most 4 voxels).
 MAX_TAPS = 8
@@ -35,10 +35,6 @@ def reconstruct(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1, fp2, radius, 
     ``wx, wy, wz`` are scratch arrays of at least ``ntaps`` entries. The sum runs z, then y,
     then x, in a fixed order, so the result does not depend on the caller's threading.
     """
-    if fkind == TENT:
-        return trilinear(data, offset, gshape, ux, uy, uz)
-    if fkind == CUBIC:
-        return tricubic(data, offset, gshape, ux, uy, uz, fp0, fp1)
     fx = int(math.floor(ux - radius)) + 1
     fy = int(math.floor(uy - radius)) + 1
     fz = int(math.floor(uz - radius)) + 1
@@ -59,22 +55,47 @@ def reconstruct(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1, fp2, radius, 
 
 
 @jit
-def trilinear(data, offset, gshape, ux, uy, uz):
-    """The tent filter's two taps per axis, unrolled (the common case, kept fast)."""
+def trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz):
+    """The tent filter's two taps per axis, unrolled (the common case, kept fast).
+
+    ``flat`` is the data raveled (C order, ``nx`` samples per row, ``nxy`` per plane);
+    ``(oz, oy, ox)`` the global index of its first sample and ``(gz, gy, gx)`` the global
+    shape. Cells inside the volume read their 8 corners at fixed offsets from one base index;
+    cells on its border clamp each index.
+    """
     ix = int(math.floor(ux))
     iy = int(math.floor(uy))
     iz = int(math.floor(uz))
     tx, ty, tz = ux - ix, uy - iy, uz - iz
-    x0 = _clamp(ix, gshape[2]) - offset[2]
-    x1 = _clamp(ix + 1, gshape[2]) - offset[2]
-    y0 = _clamp(iy, gshape[1]) - offset[1]
-    y1 = _clamp(iy + 1, gshape[1]) - offset[1]
-    z0 = _clamp(iz, gshape[0]) - offset[0]
-    z1 = _clamp(iz + 1, gshape[0]) - offset[0]
-    c00 = data[z0, y0, x0] + tx * (data[z0, y0, x1] - data[z0, y0, x0])
-    c01 = data[z0, y1, x0] + tx * (data[z0, y1, x1] - data[z0, y1, x0])
-    c10 = data[z1, y0, x0] + tx * (data[z1, y0, x1] - data[z1, y0, x0])
-    c11 = data[z1, y1, x0] + tx * (data[z1, y1, x1] - data[z1, y1, x0])
+    if 0 <= ix and ix + 1 < gx and 0 <= iy and iy + 1 < gy and 0 <= iz and iz + 1 < gz:
+        base = (iz - oz) * nxy + (iy - oy) * nx + (ix - ox)
+        d000 = flat[base]
+        d001 = flat[base + 1]
+        d010 = flat[base + nx]
+        d011 = flat[base + nx + 1]
+        d100 = flat[base + nxy]
+        d101 = flat[base + nxy + 1]
+        d110 = flat[base + nxy + nx]
+        d111 = flat[base + nxy + nx + 1]
+    else:
+        x0 = _clamp(ix, gx) - ox
+        x1 = _clamp(ix + 1, gx) - ox
+        y0 = (_clamp(iy, gy) - oy) * nx
+        y1 = (_clamp(iy + 1, gy) - oy) * nx
+        z0 = (_clamp(iz, gz) - oz) * nxy
+        z1 = (_clamp(iz + 1, gz) - oz) * nxy
+        d000 = flat[z0 + y0 + x0]
+        d001 = flat[z0 + y0 + x1]
+        d010 = flat[z0 + y1 + x0]
+        d011 = flat[z0 + y1 + x1]
+        d100 = flat[z1 + y0 + x0]
+        d101 = flat[z1 + y0 + x1]
+        d110 = flat[z1 + y1 + x0]
+        d111 = flat[z1 + y1 + x1]
+    c00 = d000 + tx * (d001 - d000)
+    c01 = d010 + tx * (d011 - d010)
+    c10 = d100 + tx * (d101 - d100)
+    c11 = d110 + tx * (d111 - d110)
     c0 = c00 + ty * (c01 - c00)
     c1 = c10 + ty * (c11 - c10)
     return c0 + tz * (c1 - c0)
@@ -97,27 +118,37 @@ def _cubic_weights(t, b, c):
 
 
 @jit
-def tricubic(data, offset, gshape, ux, uy, uz, b, c):
-    """A Mitchell-Netravali (B, C) cubic's 4 x 4 x 4 taps, unrolled (as fast as it gets)."""
+def tricubic(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz, b, c):
+    """A Mitchell-Netravali (B, C) cubic's 4 x 4 x 4 taps, unrolled; arguments as for
+    :func:`trilinear`."""
     ix = int(math.floor(ux))
     iy = int(math.floor(uy))
     iz = int(math.floor(uz))
     wx = _cubic_weights(ux - ix, b, c)
     wy = _cubic_weights(uy - iy, b, c)
     wz = _cubic_weights(uz - iz, b, c)
-    x0 = _clamp(ix - 1, gshape[2]) - offset[2]
-    x1 = _clamp(ix, gshape[2]) - offset[2]
-    x2 = _clamp(ix + 1, gshape[2]) - offset[2]
-    x3 = _clamp(ix + 2, gshape[2]) - offset[2]
     value = 0.0
+    if 1 <= ix and ix + 2 < gx and 1 <= iy and iy + 2 < gy and 1 <= iz and iz + 2 < gz:
+        base = (iz - 1 - oz) * nxy + (iy - 1 - oy) * nx + (ix - 1 - ox)
+        for cz in range(4):
+            plane = 0.0
+            for cy in range(4):
+                row = base + cz * nxy + cy * nx
+                plane += wy[cy] * (wx[0] * flat[row] + wx[1] * flat[row + 1]
+                                   + wx[2] * flat[row + 2] + wx[3] * flat[row + 3])
+            value += wz[cz] * plane
+        return value
+    x0 = _clamp(ix - 1, gx) - ox
+    x1 = _clamp(ix, gx) - ox
+    x2 = _clamp(ix + 1, gx) - ox
+    x3 = _clamp(ix + 2, gx) - ox
     for cz in range(4):
-        kz = _clamp(iz - 1 + cz, gshape[0]) - offset[0]
+        kz = (_clamp(iz - 1 + cz, gz) - oz) * nxy
         plane = 0.0
         for cy in range(4):
-            ky = _clamp(iy - 1 + cy, gshape[1]) - offset[1]
-            row = (wx[0] * data[kz, ky, x0] + wx[1] * data[kz, ky, x1]
-                   + wx[2] * data[kz, ky, x2] + wx[3] * data[kz, ky, x3])
-            plane += wy[cy] * row
+            row = kz + (_clamp(iy - 1 + cy, gy) - oy) * nx
+            plane += wy[cy] * (wx[0] * flat[row + x0] + wx[1] * flat[row + x1]
+                               + wx[2] * flat[row + x2] + wx[3] * flat[row + x3])
         value += wz[cz] * plane
     return value
 
