@@ -28,6 +28,18 @@ def _clamp(i, n):
 
 
 @jit
+def _taps(fkind, fp0, fp1, fp2, radius, ntaps, u, w, dw=None):
+    """First tap index for position ``u`` on one axis; fills its weights ``w`` (and their
+    derivatives ``dw`` when given)."""
+    first = int(math.floor(u - radius)) + 1
+    for a in range(ntaps):
+        w[a] = weight(fkind, fp0, fp1, fp2, u - (first + a))
+        if dw is not None:
+            dw[a] = derivative(fkind, fp0, fp1, fp2, u - (first + a))
+    return first
+
+
+@jit
 def reconstruct(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1, fp2, radius, ntaps,
                 wx, wy, wz):
     """Separable reconstruction ``sum f_ijk k(ux - i) k(uy - j) k(uz - k)`` at one point.
@@ -35,13 +47,9 @@ def reconstruct(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1, fp2, radius, 
     ``wx, wy, wz`` are scratch arrays of at least ``ntaps`` entries. The sum runs z, then y,
     then x, in a fixed order, so the result does not depend on the caller's threading.
     """
-    fx = int(math.floor(ux - radius)) + 1
-    fy = int(math.floor(uy - radius)) + 1
-    fz = int(math.floor(uz - radius)) + 1
-    for a in range(ntaps):
-        wx[a] = weight(fkind, fp0, fp1, fp2, ux - (fx + a))
-        wy[a] = weight(fkind, fp0, fp1, fp2, uy - (fy + a))
-        wz[a] = weight(fkind, fp0, fp1, fp2, uz - (fz + a))
+    fx = _taps(fkind, fp0, fp1, fp2, radius, ntaps, ux, wx)
+    fy = _taps(fkind, fp0, fp1, fp2, radius, ntaps, uy, wy)
+    fz = _taps(fkind, fp0, fp1, fp2, radius, ntaps, uz, wz)
     value = 0.0
     for c in range(ntaps):
         kz = _clamp(fz + c, gshape[0]) - offset[0]
@@ -161,16 +169,9 @@ def gradient(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1, fp2, radius, nta
     The derivative of the separable sum: one axis's weights replaced by the kernel's
     derivative. ``dx, dy, dz`` are scratch arrays like ``wx``.
     """
-    fx = int(math.floor(ux - radius)) + 1
-    fy = int(math.floor(uy - radius)) + 1
-    fz = int(math.floor(uz - radius)) + 1
-    for a in range(ntaps):
-        wx[a] = weight(fkind, fp0, fp1, fp2, ux - (fx + a))
-        wy[a] = weight(fkind, fp0, fp1, fp2, uy - (fy + a))
-        wz[a] = weight(fkind, fp0, fp1, fp2, uz - (fz + a))
-        dx[a] = derivative(fkind, fp0, fp1, fp2, ux - (fx + a))
-        dy[a] = derivative(fkind, fp0, fp1, fp2, uy - (fy + a))
-        dz[a] = derivative(fkind, fp0, fp1, fp2, uz - (fz + a))
+    fx = _taps(fkind, fp0, fp1, fp2, radius, ntaps, ux, wx, dx)
+    fy = _taps(fkind, fp0, fp1, fp2, radius, ntaps, uy, wy, dy)
+    fz = _taps(fkind, fp0, fp1, fp2, radius, ntaps, uz, wz, dz)
     gx = 0.0
     gy = 0.0
     gz = 0.0
