@@ -5,7 +5,6 @@ import pytest
 
 from vrlib import Glow, LookupTransfer, Phong
 
-
 VALUES = np.linspace(-0.5, 2.5, 61)
 
 
