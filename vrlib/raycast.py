@@ -13,6 +13,7 @@ from __future__ import annotations
 import math
 import time
 
+import numba
 import numpy as np
 
 from vrlib._kernels import raycast as _kernel
@@ -118,19 +119,24 @@ def footprint_mask(view, volume, empty, block):
     return marks.cumsum(axis=0).cumsum(axis=1)[:-1, :-1] > 0
 
 
-def spread_order(n):
-    """The tiles ``0 .. n-1`` in an order that spreads neighbours apart (a coprime stride), so
-    that a parallel loop's equal chunks hold equal shares of every part of the image.
+def balanced_order(costs, parts):
+    """Tile order for a parallel loop that hands each of ``parts`` threads an equal run of it.
+
+    Tiles are sorted by estimated cost and dealt to ``parts`` runs in snake order (heaviest
+    first, 0, 1, ..., p-1, p-1, ..., 0), so the runs carry nearly equal work and each holds
+    tiles from all over the image.
 
     Examples
     --------
-    >>> spread_order(5).tolist()
-    [0, 3, 1, 4, 2]
+    >>> balanced_order(np.array([5.0, 1.0, 1.0, 5.0]), 2).tolist()
+    [0, 2, 3, 1]
     """
-    stride = max(1, round(n * 0.618))
-    while math.gcd(stride, n) != 1:
-        stride += 1
-    return (np.arange(n, dtype=np.int64) * stride) % n
+    order = np.argsort(-np.asarray(costs, dtype=np.float64), kind="stable")
+    runs = [[] for _ in range(parts)]
+    for rank, tile in enumerate(order):
+        cycle, position = divmod(rank, parts)
+        runs[position if cycle % 2 == 0 else parts - 1 - position].append(tile)
+    return np.concatenate([np.asarray(run, dtype=np.int64) for run in runs])
 
 
 def render_raycast(volume, view, *, filt, transfer, step, early_termination,
@@ -154,7 +160,7 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
     stats = RenderStats(
         samples=taken,
         operations=taken * operations_per_sample(filt, shading=transfer.shading is not None),
-        bytes=int(volume.data.nbytes + rgba.nbytes + 2 * view.height * view.width * 3 * 8),
+        bytes=int(volume.data.nbytes + rgba.nbytes),
         seconds=time.perf_counter() - start,
     )
     return Image(rgba, stats)
@@ -191,7 +197,6 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
             f"filter radius {filt.radius:g} needs {ntaps} taps per axis; ray casting takes at "
             f"most {MAX_TAPS} (radius <= {MAX_TAPS // 2})"
         )
-    origins, directions = view.rays()
     tables = transfer.segment_table(ds, *value_range)
     shading = transfer.shading
     if shading is None:
@@ -204,14 +209,21 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
         skip = (np.zeros((1, 1, 1), dtype=bool), np.zeros((1, 1, 1), dtype=bool), 0,
                 np.ones(view.shape, dtype=bool))
     out = np.empty(view.shape + (4,))
-    tiles = -(-view.height // TILE[0]) * -(-view.width // TILE[1])
-    samples = np.zeros(tiles, dtype=np.int64)
+    rows, cols = -(-view.height // TILE[0]), -(-view.width // TILE[1])
+    samples = np.zeros(rows * cols, dtype=np.int64)
+    # Cost of a tile: the pixels whose rays can meet something visible (plus a little for the
+    # rest), so that threads share the work evenly.
+    mask = skip[3]
+    padded = np.zeros((rows * TILE[0], cols * TILE[1]))
+    padded[: view.height, : view.width] = mask + 0.05
+    costs = padded.reshape(rows, TILE[0], cols, TILE[1]).sum(axis=(1, 3)).ravel()
     _kernel.raycast(
         data, np.asarray(offset, np.int64), np.asarray(global_shape, np.int64),
         np.asarray(origin, np.float64), np.asarray(spacing, np.float64),
-        np.asarray(box[0], np.float64), np.asarray(box[1], np.float64), origins, directions,
+        np.asarray(box[0], np.float64), np.asarray(box[1], np.float64), view.packed(),
+        view.height, view.width,
         ds, *filt.code, filt.radius, ntaps, *tables, *lighting, early_termination, *skip, *TILE,
-        spread_order(tiles), out, samples, shading is None and bool(np.all(tables[4] == 1.0)),
+        balanced_order(costs, numba.get_num_threads()), out, samples, shading is None and bool(np.all(tables[4] == 1.0)),
     )
     np.clip(out[..., 3], 0.0, 1.0, out=out[..., 3])
     return out, int(samples.sum())

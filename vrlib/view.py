@@ -208,6 +208,20 @@ class View:
         rows = (0.5 * self.height - np.arange(self.height) - 0.5) * self._pixel
         return rows, cols
 
+    def packed(self):
+        """The view as 15 numbers for the numba kernels: centre, right, up, forward (3 each),
+        pixel width on the image plane (orthographic) or at unit distance (perspective),
+        radius, and the eye distance (0 for orthographic).
+
+        Examples
+        --------
+        >>> View([0, 0, -1], up=[0, 1, 0], size=2, radius=1.0).packed().tolist()[-3:]
+        [1.0, 1.0, 0.0]
+        """
+        distance = 0.0 if self.distance is None else self.distance
+        return np.concatenate([self.center, self._basis.ravel(),
+                               [self._pixel, self.radius, distance]])
+
     def rays(self):
         """One ray per pixel centre: ``(origins, directions)``, each ``(height, width, 3)``.
 

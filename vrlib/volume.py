@@ -131,6 +131,7 @@ class Volume:
         self._data = arr
         self._extent = _check_extent(DEFAULT_EXTENT if extent is None else extent)
         self._pyramids = {}
+        self._range = None
 
     # -- lattice geometry ------------------------------------------------------------------
 
@@ -180,8 +181,10 @@ class Volume:
 
     @property
     def value_range(self):
-        """``(min, max)`` of the samples."""
-        return float(self._data.min()), float(self._data.max())
+        """``(min, max)`` of the samples (computed once: the samples are read-only)."""
+        if self._range is None:
+            self._range = (float(self._data.min()), float(self._data.max()))
+        return self._range
 
     def index_to_world(self, index):
         """Map index coordinates ``(i, j, k)`` (x, y, z order, float) to world ``(x, y, z)``.

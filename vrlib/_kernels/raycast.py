@@ -25,7 +25,7 @@ from vrlib._kernels.sampling import MAX_TAPS, gradient, reconstruct, tricubic, t
 @jit
 def ray_box(o, d, lo, hi):
     """Parameters ``(t_in, t_out)`` where the ray ``o + t d`` crosses the box ``[lo, hi]``
-    (``t_in >= t_out`` when it misses)."""
+    (``t_in >= t_out`` when it misses); ``o`` and ``d`` are 3-tuples."""
     t_in = -math.inf
     t_out = math.inf
     for a in range(3):
@@ -40,6 +40,29 @@ def ray_box(o, d, lo, hi):
             t_in = max(t_in, ta)
             t_out = min(t_out, tb)
     return t_in, t_out
+
+
+@jit
+def pixel_ray(camera, height, width, r, c):
+    """Origin and unit direction of the ray through pixel ``(r, c)`` of a packed view
+    (:meth:`vrlib.View.packed`), as :meth:`vrlib.View.rays` computes them."""
+    px = camera[12]
+    x = (c + 0.5 - 0.5 * width) * px
+    y = (0.5 * height - r - 0.5) * px
+    fx, fy, fz = camera[9], camera[10], camera[11]
+    sx = y * camera[6] + x * camera[3]
+    sy = y * camera[7] + x * camera[4]
+    sz = y * camera[8] + x * camera[5]
+    distance = camera[14]
+    if distance == 0.0:
+        radius = camera[13]
+        o = (camera[0] - radius * fx + sx, camera[1] - radius * fy + sy,
+             camera[2] - radius * fz + sz)
+        return o, (fx, fy, fz)
+    dx, dy, dz = fx + sx, fy + sy, fz + sz
+    norm = math.sqrt(dx * dx + dy * dy + dz * dz)
+    o = (camera[0] - distance * fx, camera[1] - distance * fy, camera[2] - distance * fz)
+    return o, (dx / norm, dy / norm, dz / norm)
 
 
 @jit
@@ -85,7 +108,7 @@ def _lookup(x, n):
 
 
 @parallel_jit
-def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, ray_o, ray_d, ds,
+def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, camera, height, width, ds,
             fkind, fp0, fp1, fp2, radius, ntaps,
             tstart, tinv, alpha_tab, color_tab, emit_tab,
             shade, ka, kd, ks, shininess, light, headlight,
@@ -94,7 +117,8 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, ray_o, ray_d,
 
     ``data`` holds the samples from global index ``offset`` on (the whole volume, or a brick
     with ghost samples) of a volume of global shape ``gshape`` whose sample 0 is at world
-    ``origin``; rays sample the world box ``[box_lo, box_hi]``. The image is cut into
+    ``origin``; the rays of the packed view ``camera`` (one per pixel of a ``height x width``
+    image) sample the world box ``[box_lo, box_hi]``. The image is cut into
     ``tile_h x tile_w`` pixel tiles, taken in the order ``order`` (spread over the image so that
     threads share the work evenly); neighbouring rays read neighbouring voxels, so a tile keeps
     them in cache. Each pixel is computed independently and in a fixed order: the image does
@@ -106,7 +130,6 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, ray_o, ray_d,
     non-empty block; ``threshold = 1`` turns early ray termination off.
     ``grey`` says the emission is 1 everywhere and unshaded, so colour equals opacity.
     """
-    height, width = ray_o.shape[0], ray_o.shape[1]
     tiles_across = (width + tile_w - 1) // tile_w
     flat = data.reshape(-1)
     nx = data.shape[2]
@@ -133,8 +156,7 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, ray_o, ray_d,
             c = col0 + p % tile_w
             if r >= height or c >= width:
                 continue
-            o = ray_o[r, c]
-            d = ray_d[r, c]
+            o, d = pixel_ray(camera, height, width, r, c)
             out[r, c, 0] = 0.0
             out[r, c, 1] = 0.0
             out[r, c, 2] = 0.0
