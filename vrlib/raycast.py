@@ -208,6 +208,7 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
     if skip is None:
         skip = (np.zeros((1, 1, 1), dtype=bool), np.zeros((1, 1, 1), dtype=bool), 0,
                 np.ones(view.shape, dtype=bool))
+    grey = shading is None and bool(np.all(tables[4] == 1.0))  # colour equals opacity
     out = np.empty(view.shape + (4,))
     rows, cols = -(-view.height // TILE[0]), -(-view.width // TILE[1])
     samples = np.zeros(rows * cols, dtype=np.int64)
@@ -223,7 +224,7 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
         np.asarray(box[0], np.float64), np.asarray(box[1], np.float64), view.packed(),
         view.height, view.width,
         ds, *filt.code, filt.radius, ntaps, *tables, *lighting, early_termination, *skip, *TILE,
-        balanced_order(costs, numba.get_num_threads()), out, samples, shading is None and bool(np.all(tables[4] == 1.0)),
+        balanced_order(costs, numba.get_num_threads()), out, samples, grey,
     )
     np.clip(out[..., 3], 0.0, 1.0, out=out[..., 3])
     return out, int(samples.sum())
