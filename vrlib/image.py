@@ -28,17 +28,20 @@ class RenderStats:
         Bytes of the largest buffers the renderer held.
     seconds : float
         Wall time of the render.
+    voxels : int
+        Voxels drawn (splatting) or resampled (shearing); 0 for ray casting.
 
     Examples
     --------
     >>> RenderStats(samples=10, seconds=0.5).as_dict()
-    {'samples': 10, 'operations': 0, 'bytes': 0, 'seconds': 0.5}
+    {'samples': 10, 'operations': 0, 'bytes': 0, 'seconds': 0.5, 'voxels': 0}
     """
 
     samples: int = 0
     operations: int = 0
     bytes: int = 0
     seconds: float = 0.0
+    voxels: int = 0
 
     def as_dict(self):
         """The counters as a plain dict."""

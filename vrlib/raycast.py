@@ -18,6 +18,7 @@ import numpy as np
 
 from vrlib._kernels import raycast as _kernel
 from vrlib._kernels.sampling import MAX_TAPS
+from vrlib._scheduling import balanced_order
 from vrlib.image import Image, RenderStats
 from vrlib.skipping import empty_blocks, lattice_sums
 
@@ -117,26 +118,6 @@ def footprint_mask(view, volume, empty, block):
     np.add.at(marks, (r1, c0), -1)
     np.add.at(marks, (r1, c1), 1)
     return marks.cumsum(axis=0).cumsum(axis=1)[:-1, :-1] > 0
-
-
-def balanced_order(costs, parts):
-    """Tile order for a parallel loop that hands each of ``parts`` threads an equal run of it.
-
-    Tiles are sorted by estimated cost and dealt to ``parts`` runs in snake order (heaviest
-    first, 0, 1, ..., p-1, p-1, ..., 0), so the runs carry nearly equal work and each holds
-    tiles from all over the image.
-
-    Examples
-    --------
-    >>> balanced_order(np.array([5.0, 1.0, 1.0, 5.0]), 2).tolist()
-    [0, 2, 3, 1]
-    """
-    order = np.argsort(-np.asarray(costs, dtype=np.float64), kind="stable")
-    runs = [[] for _ in range(parts)]
-    for rank, tile in enumerate(order):
-        cycle, position = divmod(rank, parts)
-        runs[position if cycle % 2 == 0 else parts - 1 - position].append(tile)
-    return np.concatenate([np.asarray(run, dtype=np.int64) for run in runs])
 
 
 def render_raycast(volume, view, *, filt, transfer, step, early_termination,

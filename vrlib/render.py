@@ -9,15 +9,33 @@ import numba
 
 from vrlib import _validate
 from vrlib.filters import make_filter
+import inspect
+
 from vrlib.raycast import render_raycast
+from vrlib.splat import render_splat
 from vrlib.transfer import Glow, TransferFunction
 from vrlib.view import View
 from vrlib.volume import Volume
 
-__all__ = ["render", "METHODS"]
+__all__ = ["render", "METHODS", "method_options"]
 
 #: Rendering methods by name.
-METHODS = {"raycast": render_raycast}
+METHODS = {"raycast": render_raycast, "splat": render_splat}
+
+_COMMON = {"filt", "transfer", "step", "early_termination", "empty_space_skipping"}
+
+
+def method_options(method):
+    """Keyword options that one method takes beyond the common ones, with their defaults.
+
+    Examples
+    --------
+    >>> method_options("splat")
+    {'mode': 'sheet', 'footprint_resolution': 129}
+    """
+    params = inspect.signature(METHODS[method]).parameters.values()
+    return {p.name: p.default for p in params
+            if p.kind is p.KEYWORD_ONLY and p.name not in _COMMON}
 
 
 @contextlib.contextmanager
@@ -34,14 +52,14 @@ def _threads(count):
 
 
 def render(volume, view, *, method="raycast", filter="trilinear", transfer=None, step=0.5,
-           early_termination=0.999, empty_space_skipping=True, threads=None):
+           early_termination=0.999, empty_space_skipping=True, threads=None, **options):
     """Render a volume into an image.
 
     Parameters
     ----------
     volume : Volume
     view : View
-    method : {"raycast"}
+    method : {"raycast", "splat"}
         The rendering method (see :data:`METHODS`).
     filter : str, tuple or Filter, default "trilinear"
         Reconstruction filter, by name or built with :func:`vrlib.make_filter`.
@@ -58,6 +76,9 @@ def render(volume, view, *, method="raycast", filter="trilinear", transfer=None,
         the image.
     threads : int, optional
         Threads to use (default: numba's setting). The image does not depend on it.
+    **options
+        Options of the chosen method (:func:`method_options` lists them): for ``"splat"``,
+        ``mode`` ("sheet" or "direct") and ``footprint_resolution``.
 
     Returns
     -------
@@ -100,7 +121,12 @@ def render(volume, view, *, method="raycast", filter="trilinear", transfer=None,
         limit = numba.config.NUMBA_NUM_THREADS
         if not 1 <= threads <= limit:
             raise ValueError(f"threads must be between 1 and {limit}, got {threads}")
+    allowed = method_options(method)
+    unknown = sorted(set(options) - set(allowed))
+    if unknown:
+        known = ", ".join(allowed) or "none"
+        raise TypeError(f"method {method!r} takes no option {unknown[0]!r}; its options: {known}")
     with _threads(threads):
         return METHODS[method](volume, view, filt=filt, transfer=transfer, step=step,
                                early_termination=early_termination,
-                               empty_space_skipping=empty_space_skipping)
+                               empty_space_skipping=empty_space_skipping, **options)

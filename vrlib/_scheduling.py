@@ -1,0 +1,28 @@
+"""How parallel loops share out their work: each thread of a numba ``prange`` takes one
+contiguous run of the iteration space, so the order of the items decides the balance."""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = ["balanced_order"]
+
+
+def balanced_order(costs, parts):
+    """Tile order for a parallel loop that hands each of ``parts`` threads an equal run of it.
+
+    Tiles are sorted by estimated cost and dealt to ``parts`` runs in snake order (heaviest
+    first, 0, 1, ..., p-1, p-1, ..., 0), so the runs carry nearly equal work and each holds
+    tiles from all over the image.
+
+    Examples
+    --------
+    >>> balanced_order(np.array([5.0, 1.0, 1.0, 5.0]), 2).tolist()
+    [0, 2, 3, 1]
+    """
+    order = np.argsort(-np.asarray(costs, dtype=np.float64), kind="stable")
+    runs = [[] for _ in range(parts)]
+    for rank, tile in enumerate(order):
+        cycle, position = divmod(rank, parts)
+        runs[position if cycle % 2 == 0 else parts - 1 - position].append(tile)
+    return np.concatenate([np.asarray(run, dtype=np.int64) for run in runs])
