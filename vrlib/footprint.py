@@ -46,9 +46,12 @@ class Footprint:
     ----------
     kind : int
         :data:`RADIAL` (table over ``rho^2`` in ``[0, extent^2]``) or :data:`PLANAR` (table over
-        ``(v, u)`` in ``[-extent, extent]^2``, rows along ``v``).
+        ``(v, u)`` in ``[-extent_v, extent_v] x [-extent, extent]``, rows along ``v``).
     extent : float
-        World radius beyond which the footprint is zero.
+        World distance (radial), or offset along ``u`` (planar), beyond which the footprint is
+        zero.
+    extent_v : float
+        Planar: the same along ``v`` (the kernel's support projected on the view's up).
     table : ndarray
         The samples: 1-D (radial) or 2-D (planar).
     """
@@ -56,6 +59,7 @@ class Footprint:
     kind: int
     extent: float
     table: np.ndarray
+    extent_v: float = 0.0
 
     def __call__(self, u, v):
         """Footprint at plane offsets ``(u, v)`` by the table's linear (radial) or bilinear
@@ -73,9 +77,8 @@ class Footprint:
         if self.kind == RADIAL:
             pos = (u * u + v * v) / self.extent**2 * (n - 1)
             return np.interp(pos, np.arange(n), self.table, right=0.0)
-        scale = (n - 1) / (2.0 * self.extent)
-        x = (u + self.extent) * scale
-        y = (v + self.extent) * scale
+        x = (u + self.extent) * (n - 1) / (2.0 * self.extent)
+        y = (v + self.extent_v) * (n - 1) / (2.0 * self.extent_v)
         inside = (x >= 0) & (x <= n - 1) & (y >= 0) & (y <= n - 1)
         x0 = np.clip(np.floor(x).astype(int), 0, n - 2)
         y0 = np.clip(np.floor(y).astype(int), 0, n - 2)
@@ -110,25 +113,33 @@ def _planar(filt, spacing, basis, resolution):
     right, up, forward = basis
     h = np.asarray(spacing, dtype=np.float64)
     radius = filt.radius
-    extent = radius * float(np.linalg.norm(h))
-    grid = np.linspace(-extent, extent, resolution)
-    v, u = np.meshgrid(grid, grid, indexing="ij")
-    base = u[..., None] * right + v[..., None] * up  # (n, n, 3) world offsets on the plane
+    # The support is the box radius * h; its projections on the plane's axes bound the table.
+    extent_u = radius * float(np.abs(right) @ h)
+    extent_v = radius * float(np.abs(up) @ h)
+    extent = radius * float(np.linalg.norm(h))  # bounds the line's span through the support
+    grid_u = np.linspace(-extent_u, extent_u, resolution)
+    grid_v = np.linspace(-extent_v, extent_v, resolution)
     # Knots: where the line crosses p_a / h_a = integer or half-integer (box) for some axis.
     knots = np.arange(-math.ceil(radius), math.ceil(radius) + 0.5, 0.5)
-    cuts = [np.full(u.shape + (1,), -extent * 2), np.full(u.shape + (1,), extent * 2)]
-    for a in range(3):
-        if forward[a] != 0.0:
-            cuts.append((knots[None, None, :] * h[a] - base[..., a:a + 1]) / forward[a])
-    cuts = np.sort(np.clip(np.concatenate(cuts, axis=-1), -2 * extent, 2 * extent), axis=-1)
     nodes, weights = np.polynomial.legendre.leggauss(12 if isinstance(filt, Gaussian) else 6)
-    lo, hi = cuts[..., :-1], cuts[..., 1:]
-    half = 0.5 * (hi - lo)
-    t = 0.5 * (lo + hi)[..., None] + half[..., None] * nodes
-    points = base[..., None, None, :] + t[..., None] * forward
-    kernel = np.prod([filt(points[..., a] / h[a]) for a in range(3)], axis=0)
-    table = np.sum(kernel * weights * half[..., None], axis=(-1, -2))
-    return Footprint(PLANAR, extent, table)
+    table = np.empty((resolution, resolution))
+    rows = max(1, 2048 // resolution)  # table rows per pass, to bound temporary memory
+    for first in range(0, resolution, rows):
+        v, u = np.meshgrid(grid_v[first:first + rows], grid_u, indexing="ij")
+        base = u[..., None] * right + v[..., None] * up  # world offsets on the plane
+        cuts = [np.full(u.shape + (1,), -2 * extent), np.full(u.shape + (1,), 2 * extent)]
+        for a in range(3):
+            if forward[a] != 0.0:
+                cuts.append((knots * h[a] - base[..., a:a + 1]) / forward[a])
+        cuts = np.sort(np.clip(np.concatenate(cuts, axis=-1), -2 * extent, 2 * extent), axis=-1)
+        lo, hi = cuts[..., :-1], cuts[..., 1:]
+        half = 0.5 * (hi - lo)
+        t = 0.5 * (lo + hi)[..., None] + half[..., None] * nodes
+        kernel = np.ones(t.shape)
+        for a in range(3):
+            kernel *= filt((base[..., None, None, a] + t * forward[a]) / h[a])
+        table[first:first + rows] = np.sum(kernel * weights * half[..., None], axis=(-1, -2))
+    return Footprint(PLANAR, extent_u, table, extent_v)
 
 
 @functools.lru_cache(maxsize=32)

@@ -3,14 +3,13 @@
 from __future__ import annotations
 
 import contextlib
+import inspect
 import numbers
 
 import numba
 
 from vrlib import _validate
 from vrlib.filters import make_filter
-import inspect
-
 from vrlib.raycast import render_raycast
 from vrlib.splat import render_splat
 from vrlib.transfer import Glow, TransferFunction

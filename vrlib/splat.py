@@ -87,7 +87,7 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
         raise ValueError("part of the volume lies behind the eye: splatting cannot draw it; "
                          "move the eye back or use method='raycast'")
     pixel_depth = view.pixel_size if view.eye is None else view.pixel_size / view.distance * depth
-    reach_max = fp.extent / pixel_depth
+    reach_max = max(fp.extent, fp.extent_v) / pixel_depth
     # Values a sheet can hold lie within the reconstruction's bounds; widen them generously
     # (the tables are exact inside and clamp outside).
     lo, hi = reconstructed_range(volume, filt)
@@ -103,7 +103,8 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
     start = time.perf_counter()
     _kernel.splat(
         volume.data, volume.origin, spacing, view.packed(), view.height, view.width, axis,
-        slices, fp.kind, fp.extent, fp.table if fp.kind == RADIAL else dummy1,
+        slices, fp.kind, fp.extent, fp.extent_v or fp.extent,
+        fp.table if fp.kind == RADIAL else dummy1,
         fp.table if fp.kind != RADIAL else dummy2, MODES.index(mode), vstart, vinv, density,
         emission, early_termination, empty_space_skipping, reach_max, BAND,
         balanced_order(np.ones(bands), numba.get_num_threads()), out, voxels, pixels,

@@ -19,7 +19,14 @@ from numba import prange
 
 from vrlib._kernels._jit import jit, parallel_jit
 from vrlib._kernels.filters import CUBIC, TENT
-from vrlib._kernels.sampling import MAX_TAPS, gradient, reconstruct, tricubic, trilinear
+from vrlib._kernels.sampling import (
+    MAX_TAPS,
+    gradient,
+    reconstruct,
+    separable4,
+    tricubic,
+    trilinear,
+)
 
 
 @jit
@@ -213,6 +220,9 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, camera, heigh
                 elif fkind == CUBIC:
                     value = tricubic(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz,
                                      fp0, fp1)
+                elif ntaps == 4:
+                    value = separable4(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz,
+                                       fkind, fp0, fp1, fp2, radius)
                 else:
                     value = reconstruct(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1, fp2,
                                         radius, ntaps, wx, wy, wz)

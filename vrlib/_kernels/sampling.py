@@ -12,7 +12,7 @@ from __future__ import annotations
 import math
 
 from vrlib._kernels._jit import jit
-from vrlib._kernels.filters import derivative, weight
+from vrlib._kernels.filters import GAUSSIAN, derivative, weight
 
 #: Largest number of taps per axis (a filter radius of at most 4 voxels).
 MAX_TAPS = 8
@@ -127,17 +127,59 @@ def _cubic_weights(t, b, c):
 
 @jit
 def tricubic(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz, b, c):
-    """A Mitchell-Netravali (B, C) cubic's 4 x 4 x 4 taps, unrolled; arguments as for
+    """A Mitchell-Netravali (B, C) cubic's 4 x 4 x 4 taps; arguments as for
     :func:`trilinear`."""
     ix = int(math.floor(ux))
     iy = int(math.floor(uy))
     iz = int(math.floor(uz))
-    wx = _cubic_weights(ux - ix, b, c)
-    wy = _cubic_weights(uy - iy, b, c)
-    wz = _cubic_weights(uz - iz, b, c)
+    return four_taps(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ix - 1, iy - 1, iz - 1,
+                     _cubic_weights(ux - ix, b, c), _cubic_weights(uy - iy, b, c),
+                     _cubic_weights(uz - iz, b, c))
+
+
+@jit
+def _four_weights(fkind, fp0, fp1, fp2, u, first):
+    if fkind == GAUSSIAN:
+        # exp(-(d - a)^2 / 2s^2) = exp(-d^2 / 2s^2) exp(d / s^2)^a exp(-a^2 / 2s^2): two
+        # exponentials per axis instead of four.
+        d = u - first
+        inv = 1.0 / (fp0 * fp0)
+        w0 = math.exp(-0.5 * d * d * inv) * fp2
+        step = math.exp(d * inv)
+        c1 = math.exp(-0.5 * inv)
+        w1 = w0 * step * c1
+        w2 = w1 * step * c1 * c1 * c1
+        w3 = w2 * step * c1 * c1 * c1 * c1 * c1
+        return (w0 if abs(d) < fp1 else 0.0, w1 if abs(d - 1.0) < fp1 else 0.0,
+                w2 if abs(d - 2.0) < fp1 else 0.0, w3 if abs(d - 3.0) < fp1 else 0.0)
+    return (weight(fkind, fp0, fp1, fp2, u - first),
+            weight(fkind, fp0, fp1, fp2, u - first - 1),
+            weight(fkind, fp0, fp1, fp2, u - first - 2),
+            weight(fkind, fp0, fp1, fp2, u - first - 3))
+
+
+@jit
+def separable4(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz, fkind, fp0, fp1, fp2,
+               radius):
+    """Any filter with 4 taps per axis (radius in (1.5, 2]), e.g. the Gaussian; arguments as
+    for :func:`trilinear` plus the filter."""
+    fx = int(math.floor(ux - radius)) + 1
+    fy = int(math.floor(uy - radius)) + 1
+    fz = int(math.floor(uz - radius)) + 1
+    return four_taps(flat, nx, nxy, oz, oy, ox, gz, gy, gx, fx, fy, fz,
+                     _four_weights(fkind, fp0, fp1, fp2, ux, fx),
+                     _four_weights(fkind, fp0, fp1, fp2, uy, fy),
+                     _four_weights(fkind, fp0, fp1, fp2, uz, fz))
+
+
+@jit
+def four_taps(flat, nx, nxy, oz, oy, ox, gz, gy, gx, fx, fy, fz, wx, wy, wz):
+    """Sum of 4 x 4 x 4 samples from global index ``(fx, fy, fz)`` on, weighted by the
+    4-tuples ``wx, wy, wz``, unrolled along x and reading from one base index inside the
+    volume (indices clamped at its border)."""
     value = 0.0
-    if 1 <= ix and ix + 2 < gx and 1 <= iy and iy + 2 < gy and 1 <= iz and iz + 2 < gz:
-        base = (iz - 1 - oz) * nxy + (iy - 1 - oy) * nx + (ix - 1 - ox)
+    if 0 <= fx and fx + 3 < gx and 0 <= fy and fy + 3 < gy and 0 <= fz and fz + 3 < gz:
+        base = (fz - oz) * nxy + (fy - oy) * nx + (fx - ox)
         for cz in range(4):
             plane = 0.0
             for cy in range(4):
@@ -146,15 +188,15 @@ def tricubic(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz, b, c):
                                    + wx[2] * flat[row + 2] + wx[3] * flat[row + 3])
             value += wz[cz] * plane
         return value
-    x0 = _clamp(ix - 1, gx) - ox
-    x1 = _clamp(ix, gx) - ox
-    x2 = _clamp(ix + 1, gx) - ox
-    x3 = _clamp(ix + 2, gx) - ox
+    x0 = _clamp(fx, gx) - ox
+    x1 = _clamp(fx + 1, gx) - ox
+    x2 = _clamp(fx + 2, gx) - ox
+    x3 = _clamp(fx + 3, gx) - ox
     for cz in range(4):
-        kz = (_clamp(iz - 1 + cz, gz) - oz) * nxy
+        kz = (_clamp(fz + cz, gz) - oz) * nxy
         plane = 0.0
         for cy in range(4):
-            row = kz + (_clamp(iy - 1 + cy, gy) - oy) * nx
+            row = kz + (_clamp(fy + cy, gy) - oy) * nx
             plane += wy[cy] * (wx[0] * flat[row + x0] + wx[1] * flat[row + x1]
                                + wx[2] * flat[row + x2] + wx[3] * flat[row + x3])
         value += wz[cz] * plane

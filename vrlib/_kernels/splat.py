@@ -60,7 +60,7 @@ def _emission(start, inv, tab, value, channel):
 
 
 @jit
-def footprint_at(kind, extent, radial, planar, u, v):
+def footprint_at(kind, extent, extent_v, radial, planar, u, v):
     """Footprint at plane offsets (u, v): linear in rho^2 (radial) or bilinear (planar)."""
     if kind == RADIAL:
         n = radial.shape[0]
@@ -71,9 +71,8 @@ def footprint_at(kind, extent, radial, planar, u, v):
         w = x - i
         return radial[i] + w * (radial[i + 1] - radial[i])
     n = planar.shape[0]
-    scale = (n - 1) / (2.0 * extent)
-    x = (u + extent) * scale
-    y = (v + extent) * scale
+    x = (u + extent) * ((n - 1) / (2.0 * extent))
+    y = (v + extent_v) * ((n - 1) / (2.0 * extent_v))
     if not (x >= 0.0 and y >= 0.0 and x <= n - 1 and y <= n - 1):
         return 0.0
     i = min(int(x), n - 2)
@@ -159,7 +158,7 @@ def _project(camera, height, width, x, y, z):
 
 @parallel_jit
 def splat(data, origin, spacing, camera, height, width, axis, slices,
-          fkind, extent, radial, planar, mode, vstart, vinv, dens_tab, emit_tab,
+          fkind, extent, extent_v, radial, planar, mode, vstart, vinv, dens_tab, emit_tab,
           threshold, cull, reach_max, band, order, out, voxels, pixels):
     """Splat ``data[z, y, x]`` into ``out`` (premultiplied RGBA), bands of ``band`` rows.
 
@@ -167,8 +166,8 @@ def splat(data, origin, spacing, camera, height, width, axis, slices,
     back. Footprints are ``fkind`` tables (:mod:`vrlib.footprint`) reaching ``extent`` world
     units. Classification reads density and emission tables over values (``vstart``,
     ``vinv``). With ``cull``, voxels of value zero are never drawn (they add nothing to a sheet)
-    and in direct mode neither are voxels of zero density. Pixels whose opacity has reached ``threshold``
-    take no more (1 turns that off). ``reach_max`` bounds the footprint radius in pixels over the
+    and in direct mode neither are voxels of zero density. Pixels whose opacity has reached
+    ``threshold`` take no more (1 turns that off). ``reach_max`` bounds the footprint radius in pixels over the
     volume. ``voxels`` and ``pixels`` count, per band, the voxels whose centre falls on it and
     the footprint pixels drawn.
     """
@@ -221,13 +220,14 @@ def splat(data, origin, spacing, camera, height, width, axis, slices,
                     row_c, col_c, depth = _project(camera, height, width, x, y, z)
                     if not depth > 0.0 or row_c != row_c:
                         continue
-                    reach = extent / px / depth if perspective else extent / px
-                    top = max(r0, int(math.ceil(row_c - reach - 0.5)))
-                    bottom = min(r1 - 1, int(math.floor(row_c + reach - 0.5)))
+                    reach_u = extent / px / depth if perspective else extent / px
+                    reach_v = extent_v / px / depth if perspective else extent_v / px
+                    top = max(r0, int(math.ceil(row_c - reach_v - 0.5)))
+                    bottom = min(r1 - 1, int(math.floor(row_c + reach_v - 0.5)))
                     if top > bottom:
                         continue
-                    left = max(0, int(math.ceil(col_c - reach - 0.5)))
-                    right = min(width - 1, int(math.floor(col_c + reach - 0.5)))
+                    left = max(0, int(math.ceil(col_c - reach_u - 0.5)))
+                    right = min(width - 1, int(math.floor(col_c + reach_u - 0.5)))
                     if left > right:
                         continue
                     if r0 <= row_c < r1 or (b == 0 and row_c < 0) or (
@@ -252,7 +252,7 @@ def splat(data, origin, spacing, camera, height, width, axis, slices,
                             else:
                                 u = (c + 0.5 - col_c) * px
                                 v = (row_c - r - 0.5) * px
-                            fp = footprint_at(fkind, extent, radial, planar, u, v)
+                            fp = footprint_at(fkind, extent, extent_v, radial, planar, u, v)
                             if fp == 0.0:
                                 continue
                             drawn += 1
