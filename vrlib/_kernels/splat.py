@@ -163,13 +163,14 @@ def splat(data, origin, spacing, camera, height, width, axis, slices,
     """Splat ``data[z, y, x]`` into ``out`` (premultiplied RGBA), bands of ``band`` rows.
 
     ``axis`` (0, 1, 2 for x, y, z) is the slicing axis and ``slices`` its indices front to
-    back. Footprints are ``fkind`` tables (:mod:`vrlib.footprint`) reaching ``extent`` world
-    units. Classification reads density and emission tables over values (``vstart``,
-    ``vinv``). With ``cull``, voxels of value zero are never drawn (they add nothing to a sheet)
-    and in direct mode neither are voxels of zero density. Pixels whose opacity has reached
-    ``threshold`` take no more (1 turns that off). ``reach_max`` bounds the footprint radius in pixels over the
-    volume. ``voxels`` and ``pixels`` count, per band, the voxels whose centre falls on it and
-    the footprint pixels drawn.
+    back. Footprints are ``fkind`` tables (:mod:`vrlib.footprint`) reaching ``extent`` (along
+    the image's right) and ``extent_v`` (up) world units. Classification reads density and
+    emission tables over values (``vstart``, ``vinv``). With ``cull``, voxels of value zero are
+    never drawn (they add nothing to a sheet) and in direct mode neither are voxels of zero
+    density. Pixels whose opacity has reached ``threshold`` take no more (1 turns that off).
+    ``reach_max`` bounds the footprint's reach in pixels over the volume. ``voxels`` and
+    ``pixels`` count, per band, the voxels whose centre falls on it and the footprint pixels
+    drawn.
     """
     nz, ny, nx = data.shape
     counts = (nx, ny, nz)
