@@ -34,6 +34,8 @@ __all__ = ["render_splat", "MODES", "major_axis"]
 MODES = ("sheet", "direct")
 #: Image rows per parallel task.
 BAND = 16
+#: Largest filter radius (voxels) the splatter takes, as for the ray caster.
+MAX_RADIUS = 4.0
 
 
 def major_axis(volume, view):
@@ -69,6 +71,9 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
         Footprint table entries per axis (:func:`vrlib.footprint.footprint`).
     """
     _validate.choice("mode", mode, MODES)
+    if filt.radius > MAX_RADIUS:
+        raise ValueError(f"filter radius {filt.radius:g} is out of range: splatting takes radii "
+                         f"up to {MAX_RADIUS} voxels")
     if transfer.shading is not None:
         raise ValueError("splatting does not shade (it reconstructs no gradients); "
                          "use method='raycast' for shaded images")
