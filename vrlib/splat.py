@@ -58,6 +58,58 @@ def major_axis(volume, view):
     return axis, bool(direction[axis] > 0)
 
 
+def _slice_order(array, axis):
+    """A ``[z, y, x]`` array as ``[slice, p, q]`` for slicing ``axis`` (0, 1, 2: x, y, z), with
+    p and q the other axes in increasing order (a view, no copy)."""
+    p_axis, q_axis = [a for a in range(3) if a != axis]
+    return np.transpose(array, (2 - axis, 2 - p_axis, 2 - q_axis))
+
+
+def drawable(volume, transfer, mode):
+    """Nonzero where the splatter must draw: the samples themselves (sheet mode; zeros add
+    nothing to a sheet), or a mask of nonzero density (direct mode, evaluated a z-slab at a
+    time).
+
+    Examples
+    --------
+    >>> from vrlib import Volume, Glow
+    >>> drawable(Volume(np.array([[[0.0, -1.0], [2.0, 0.0]]] * 2)), Glow(1.0), "direct")[0]
+    array([[False, False],
+           [ True, False]])
+    """
+    if mode == "sheet":
+        return volume.data  # nonzero values are the ones to draw
+    mask = np.empty(volume.shape, dtype=bool)
+    for z in range(0, volume.shape[0], 16):
+        mask[z:z + 16] = transfer.opacity_density(volume.data[z:z + 16]) > 0.0
+    return mask
+
+
+def row_extents(volume, axis, marks):
+    """For every row ``(slice, p)`` of the slicing order, the first and last ``q`` whose entry in
+    ``marks`` (``[z, y, x]``, bool or numbers) is nonzero: ``first > last`` for an empty row.
+
+    Examples
+    --------
+    >>> from vrlib import Volume
+    >>> marks = np.zeros((2, 2, 3), bool); marks[0, 1, 1:] = True
+    >>> first, last = row_extents(Volume(np.zeros((2, 2, 3))), 2, marks)
+    >>> first.tolist(), last.tolist()      # slices along z, rows along x, q along y
+    ([[2, 1, 1], [2, 2, 2]], [[-1, 1, 1], [-1, -1, -1]])
+    """
+    shape = _slice_order(marks, axis).shape[:2]
+    first = np.empty(shape, np.int64)
+    last = np.empty(shape, np.int64)
+    _kernel.row_extents(marks, axis, first, last)
+    return first, last
+
+
+def full_extents(volume, axis):
+    """Row extents that keep every voxel (no culling)."""
+    shape = _slice_order(volume.data, axis).shape
+    return (np.zeros(shape[:2], np.int64), np.full(shape[:2], shape[2] - 1, np.int64))
+
+
 def render_splat(volume, view, *, filt, transfer, step, early_termination, empty_space_skipping,
                  mode="sheet", footprint_resolution=129):
     """Splat ``volume`` (arguments validated by :func:`vrlib.render`; ``step`` is unused:
@@ -98,6 +150,8 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
     lo, hi = reconstructed_range(volume, filt)
     span = hi - lo
     vstart, vinv, density, emission = transfer.value_table(lo - 2 * span, hi + 2 * span)
+    first, last = row_extents(volume, axis, drawable(volume, transfer, mode)) if (
+        empty_space_skipping) else full_extents(volume, axis)
     n_slices = volume.shape[2 - axis]
     slices = np.arange(n_slices) if ascending else np.arange(n_slices)[::-1]
     bands = -(-view.height // BAND)
@@ -111,7 +165,7 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
         slices, fp.kind, fp.extent, fp.extent_v or fp.extent,
         fp.table if fp.kind == RADIAL else dummy1,
         fp.table if fp.kind != RADIAL else dummy2, MODES.index(mode), vstart, vinv, density,
-        emission, early_termination, empty_space_skipping, reach_max, BAND,
+        emission, early_termination, empty_space_skipping, first, last, reach_max, BAND,
         balanced_order(np.ones(bands), numba.get_num_threads()), out, voxels, pixels,
     )
     drawn = int(pixels.sum())

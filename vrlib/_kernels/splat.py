@@ -157,9 +157,35 @@ def _project(camera, height, width, x, y, z):
 
 
 @parallel_jit
+def row_extents(marks, axis, first, last):
+    """For each row ``(s, p)`` of the slicing order along ``axis``, the first and last ``q``
+    with a nonzero entry in ``marks[z, y, x]`` (``first = nq``, ``last = -1`` when none)."""
+    nz, ny, nx = marks.shape
+    counts = (nx, ny, nz)
+    pa = 1 if axis == 0 else 0
+    qa = 1 if axis == 2 else 2
+    nq = counts[qa]
+    for slice_index in prange(counts[axis]):
+        s = np.int64(slice_index)  # prange counts unsigned; keep the index arithmetic signed
+        for p in range(counts[pa]):
+            lo = nq
+            hi = -1
+            for q in range(nq):
+                i = s if axis == 0 else p
+                j = s if axis == 1 else (p if axis == 0 else q)
+                k = s if axis == 2 else q
+                if marks[k, j, i] != 0:
+                    if lo == nq:
+                        lo = q
+                    hi = q
+            first[s, p] = lo
+            last[s, p] = hi
+
+
+@parallel_jit
 def splat(data, origin, spacing, camera, height, width, axis, slices,
           fkind, extent, extent_v, radial, planar, mode, vstart, vinv, dens_tab, emit_tab,
-          threshold, cull, reach_max, band, order, out, voxels, pixels):
+          threshold, cull, row_first, row_last, reach_max, band, order, out, voxels, pixels):
     """Splat ``data[z, y, x]`` into ``out`` (premultiplied RGBA), bands of ``band`` rows.
 
     ``axis`` (0, 1, 2 for x, y, z) is the slicing axis and ``slices`` its indices front to
@@ -168,6 +194,8 @@ def splat(data, origin, spacing, camera, height, width, axis, slices,
     emission tables over values (``vstart``, ``vinv``). With ``cull``, voxels of value zero are
     never drawn (they add nothing to a sheet) and in direct mode neither are voxels of zero
     density. Pixels whose opacity has reached ``threshold`` take no more (1 turns that off).
+    ``row_first[s, p]`` and ``row_last[s, p]`` bound the voxels of each row of each slice that
+    can be drawn (the rest are culled: a run-length skip over empty rows and their ends).
     ``reach_max`` bounds the footprint's reach in pixels over the volume. ``voxels`` and
     ``pixels`` count, per band, the voxels whose centre falls on it and the footprint pixels
     drawn.
@@ -195,6 +223,8 @@ def splat(data, origin, spacing, camera, height, width, axis, slices,
         qz = spacing[2] if qa == 2 else 0.0
         for s in slices:
             for p in range(np_):
+                if row_first[s, p] > row_last[s, p]:
+                    continue  # nothing to draw in this row
                 # Voxel (i, j, k) of slice s, in-plane row p, and q = 0.
                 i = s if axis == 0 else p
                 j = s if axis == 1 else (p if axis == 0 else 0)
@@ -203,6 +233,8 @@ def splat(data, origin, spacing, camera, height, width, axis, slices,
                     camera, height, origin[0] + i * spacing[0], origin[1] + j * spacing[1],
                     origin[2] + k * spacing[2], qx, qy, qz, nq, r0 - reach_max - 1.0,
                     r1 + reach_max + 1.0)
+                q_first = max(q_first, row_first[s, p])
+                q_last = min(q_last, row_last[s, p])
                 for q in range(q_first, q_last + 1):
                     if qa == 1:
                         j = q
