@@ -15,24 +15,21 @@ Prints a table (times are the best of three; ratios are ours / VTK's) and writes
 
 from __future__ import annotations
 
-import json
 import os
 import platform
 import subprocess
 import sys
 import time
 import tracemalloc
-from pathlib import Path
 
 os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 
 import numpy as np  # noqa: E402
+from _report import markdown, write_record  # noqa: E402
 
 import data_gen  # noqa: E402
 import vrlib  # noqa: E402
-from vrlib._io import atomic_path  # noqa: E402
 
-ROOT = Path(__file__).resolve().parent.parent
 N, SIZE, STEP = 256, 512, 1.0
 VIEW = {"azimuth": 30.0, "elevation": 20.0}
 
@@ -202,17 +199,11 @@ def main():
               "VTK rmse", "Msamples/s", "ours 1t/2t", "VTK 1t/2t", "skip speedup",
               "ours step 2 (s, rmse)", "Catmull-Rom (s, rmse)", "peak extra / volume (MiB)"]
     print(f"\n256^3 -> 512^2, parallel projection, step {STEP} voxel, trilinear unless named\n")
-    print("| " + " | ".join(header) + " |")
-    print("|" + "---|" * len(header))
-    for row in rows:
-        print("| " + " | ".join(row) + " |")
+    print(markdown(header, rows))
     for f, t in record["jit"].items():
         print(f"JIT, first render in a new process, {f}: {t['cold_s']:.2f} s with an empty "
               f"cache, {t['cached_s']:.2f} s from the cache (one kernel serves every filter)")
-    out = ROOT / "build" / "results" / "benchmarks" / "raycast_vtk.json"
-    with atomic_path(out) as tmp:
-        tmp.write_text(json.dumps(record, indent=2) + "\n")
-    print(f"\nwritten: {out.relative_to(ROOT)}")
+    write_record("raycast_vtk", record)
 
 
 if __name__ == "__main__":

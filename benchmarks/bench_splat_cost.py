@@ -13,20 +13,17 @@ Writes ``build/results/benchmarks/splat_cost.json``.
 
 from __future__ import annotations
 
-import json
 import os
 import platform
 import time
 import tracemalloc
-from pathlib import Path
 
 import numpy as np
+from _report import markdown, write_record
 
 import data_gen
 from vrlib import Glow, View, Volume, render
-from vrlib._io import atomic_path
 
-ROOT = Path(__file__).resolve().parent.parent
 N = 128
 FILTERS = ("trilinear", "gaussian", "catmull-rom")
 
@@ -126,19 +123,13 @@ def main():
                     print("| " + " | ".join(lines[-1]) + " |", flush=True)
     print(f"\n{N}^3 volume; image {N - 1} sqrt(3) m pixels wide; Glow(1); ray step 1 voxel; "
           "ns per point at the given thread count\n")
-    print("| " + " | ".join(header) + " |")
-    print("|" + "---|" * len(header))
-    for line in lines:
-        print("| " + " | ".join(line) + " |")
+    print(markdown(header, lines))
     record["footprint_errors"] = footprint_errors()
     print("\nfootprint table: largest error / peak, against 1025 entries per axis")
     print("| filter | 33 | 65 | 129 (default) | 257 |\n|---|---|---|---|---|")
     for filt, errors in record["footprint_errors"]:
         print(f"| {filt} | " + " | ".join(f"{e:.1e}" for e in errors) + " |")
-    out = ROOT / "build" / "results" / "benchmarks" / "splat_cost.json"
-    with atomic_path(out) as tmp:
-        tmp.write_text(json.dumps(record, indent=2) + "\n")
-    print(f"\nwritten: {out.relative_to(ROOT)}")
+    write_record("splat_cost", record)
 
 
 if __name__ == "__main__":

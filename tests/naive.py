@@ -8,6 +8,32 @@ import math
 
 import numpy as np
 
+from vrlib.reference import _clip_to_box
+
+
+def random_orbits(count, *, seed, size):
+    """``count`` orthographic views from random directions (reproducible)."""
+    from vrlib import View
+
+    rng = np.random.default_rng(seed)
+    return [View.orbit(azimuth=a, elevation=e, size=size)
+            for a, e in zip(rng.uniform(-180, 180, count), rng.uniform(-90, 90, count),
+                            strict=True)]
+
+
+def image_mass(image, view):
+    """Brief section 2: sum over pixels of -ln(1 - alpha) times the pixel's area, which equals
+    k times the integral of the field for a Glow(k) image that sees the whole volume."""
+    return float(-np.log1p(-image.alpha).sum() * view.pixel_size**2)
+
+
+def exact_blob_image(field, view, scale):
+    """Closed-form Glow image of an analytic field with exact line integrals (brief section 2):
+    ``1 - exp(-k * line integral)``, each ray clipped to the field's box."""
+    o, d = view.rays()
+    t0, t1 = _clip_to_box(o, d, field.bounds[:, 0], field.bounds[:, 1])
+    return 1.0 - np.exp(-scale * field.line_integral(o, d, t0, t1))
+
 
 def reconstruct_naive(volume, filt, points_index, *, gradient=False):
     """Separable reconstruction at index positions ``(n, 3)`` (x, y, z), edge-clamped.

@@ -122,7 +122,7 @@ def test_gaussian_ripple_follows_poisson_summation():
         if brief is not None:
             assert ripple == pytest.approx(brief, rel=0.05)
         else:
-            assert 1.2e-4 < ripple < 1.3e-4
+            assert ripple == pytest.approx(1.26e-4, rel=0.02)
 
 
 @pytest.mark.parametrize("spec", ALL, ids=str)

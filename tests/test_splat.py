@@ -3,14 +3,13 @@
 import numba
 import numpy as np
 import pytest
-from naive import splat_naive
+from naive import exact_blob_image, image_mass, random_orbits, splat_naive
 from scipy import integrate
 
 import data_gen
 import vrlib
 from vrlib import Glow, LookupTransfer, Phong, View, Volume, metrics, render
 from vrlib.footprint import PLANAR, RADIAL, footprint
-from vrlib.reference import _clip_to_box
 from vrlib.splat import major_axis
 
 TABLE = LookupTransfer([0.0, 3.0, 1.0, 5.0], [[1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 1]])
@@ -163,12 +162,6 @@ def test_opaque_pixels_take_nothing_more():
             assert early.stats.samples < full.stats.samples
 
 
-def exact_blob_image(field, view, scale):
-    o, d = view.rays()
-    t0, t1 = _clip_to_box(o, d, field.bounds[:, 0], field.bounds[:, 1])
-    return 1.0 - np.exp(-scale * field.line_integral(o, d, t0, t1))
-
-
 @pytest.mark.parametrize("filt", ["box", "trilinear", "catmull-rom", "bspline", "mitchell",
                                   "gaussian"])
 def test_glow_blob_against_closed_form(filt):
@@ -210,14 +203,10 @@ def test_mass_invariant_over_random_orbits():
     vol = field.sample(48)
     k = 1.5
     expected = k * field.integral(field.bounds)
-    rng = np.random.default_rng(11)
-    for azimuth, elevation in zip(rng.uniform(-180, 180, 8), rng.uniform(-90, 90, 8),
-                                  strict=True):
-        view = View.orbit(azimuth=azimuth, elevation=elevation, size=96)
+    for view in random_orbits(8, seed=11, size=96):
         for filt in ("trilinear", "gaussian"):
             img = render(vol, view, method="splat", filter=filt, transfer=Glow(k))
-            mass = -np.log1p(-img.alpha).sum() * view.pixel_size**2
-            assert mass == pytest.approx(expected, rel=1e-2)
+            assert image_mass(img, view) == pytest.approx(expected, rel=1e-2)
 
 
 def test_splat_and_raycast_agree():

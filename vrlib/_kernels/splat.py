@@ -134,26 +134,13 @@ def _q_range(camera, height, x0, y0, z0, dx, dy, dz, nq, row_lo, row_hi):
 @jit
 def _project(camera, height, width, x, y, z):
     """Continuous image position (row, col) and depth of a world point (as View.project)."""
-    distance = camera[14]
-    px = camera[12]
-    if distance == 0.0:
-        radius = camera[13]
-        sx = x - (camera[0] - radius * camera[9])
-        sy = y - (camera[1] - radius * camera[10])
-        sz = z - (camera[2] - radius * camera[11])
-    else:
-        sx = x - (camera[0] - distance * camera[9])
-        sy = y - (camera[1] - distance * camera[10])
-        sz = z - (camera[2] - distance * camera[11])
-    cx = sx * camera[3] + sy * camera[4] + sz * camera[5]
-    cy = sx * camera[6] + sy * camera[7] + sz * camera[8]
-    depth = sx * camera[9] + sy * camera[10] + sz * camera[11]
-    if distance != 0.0:
+    cx, cy, depth = _camera_coords(camera, x, y, z)
+    if camera[14] != 0.0:
         if depth <= 0.0:
             return math.nan, math.nan, depth
         cx /= depth
         cy /= depth
-    return 0.5 * height - cy / px, cx / px + 0.5 * width, depth
+    return 0.5 * height - cy / camera[12], cx / camera[12] + 0.5 * width, depth
 
 
 @parallel_jit
