@@ -1,0 +1,134 @@
+"""Kernels of the volume-shearing renderers: 1-D resampling passes and compositing.
+
+A pass resamples along the last axis of its (possibly transposed) source: output line
+``out[s, r, :]`` takes, at output position ``q``, the source line ``src[s, r, :]`` at
+``pos = (q - offset - c1 r - c2 s) / c0`` (a scaled shear, eq. "x' = Ax + B" of the thesis's
+section 1.2), reconstructed with a 1-D filter whose taps are clamped at the line's ends. Only
+outputs whose ``pos`` lies within the line (widened by the filter's reach) are computed; the
+rest stay zero. The compositing kernels read the last intermediate volume along the view.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import prange
+
+from vrlib._kernels._jit import jit, parallel_jit
+from vrlib._kernels.filters import weight
+from vrlib._kernels.raycast import _lookup
+
+
+@jit
+def _clamp(i, n):
+    if i < 0:
+        return 0
+    if i > n - 1:
+        return n - 1
+    return i
+
+
+@parallel_jit
+def shear_pass(src, out, c0, c1, c2, offset, fkind, fp0, fp1, fp2, radius, ntaps, counts):
+    """One resampling pass (see the module docstring); ``counts[s]`` gets the outputs computed
+    for outer index ``s``."""
+    n_s, n_r, n_q = out.shape
+    n = src.shape[2]
+    reach = radius
+    for s_index in prange(n_s):
+        s = np.int64(s_index)
+        done = 0
+        for r in range(n_r):
+            base = offset + c1 * r + c2 * s
+            # Output positions q = base + c0 pos whose source pos lies in [-reach, n-1+reach].
+            q_a = base - c0 * reach
+            q_b = base + c0 * (n - 1 + reach)
+            q_first = max(0, int(math.ceil(min(q_a, q_b))))
+            q_last = min(n_q - 1, int(math.floor(max(q_a, q_b))))
+            for q in range(q_first, q_last + 1):
+                pos = (q - base) / c0
+                first = int(math.floor(pos - radius)) + 1
+                acc = 0.0
+                for a in range(ntaps):
+                    acc += weight(fkind, fp0, fp1, fp2, pos - (first + a)) * src[
+                        s, r, _clamp(first + a, n)]
+                out[s, r, q] = acc
+                done += 1
+        counts[s] += done
+
+
+@jit
+def _classify_over(value, tstart, tinv, alpha_tab, color_tab, acc):
+    """Classify one sample from the segment table and composite it under ``acc`` (eqs 1.7-1.8,
+    colour E alpha: eq 1.9)."""
+    i, w = _lookup((value - tstart) * tinv, alpha_tab.shape[0])
+    alpha = alpha_tab[i] + w * (alpha_tab[i + 1] - alpha_tab[i])
+    if alpha > 0.0:
+        remaining = 1.0 - acc[3]
+        for ch in range(3):
+            acc[ch] += remaining * (color_tab[i, ch] + w * (color_tab[i + 1, ch]
+                                                              - color_tab[i, ch]))
+        acc[3] += remaining * alpha
+
+
+@parallel_jit
+def composite_lattice(vol, inverse, shift, limits, tstart, tinv, alpha_tab, color_tab,
+                      threshold, out, counts):
+    """Three-pass compositing: ``vol[Z, Y, X]`` lies on the image lattice; each pixel takes its
+    samples in order of increasing ``Z`` (front to back). A sample belongs to the volume when
+    ``inverse @ ((X, Y, Z) - shift)`` lies within ``[0, limits]`` on every axis."""
+    n_z, height, width = vol.shape
+    for row_index in prange(height):
+        y = np.int64(row_index)
+        acc = np.zeros(4)
+        done = 0
+        for x in range(width):
+            acc[:] = 0.0
+            for z in range(n_z):
+                inside = True
+                for a in range(3):
+                    u = (inverse[a, 0] * (x - shift[0]) + inverse[a, 1] * (y - shift[1])
+                         + inverse[a, 2] * (z - shift[2]))
+                    if u < 0.0 or u > limits[a]:
+                        inside = False
+                if not inside:
+                    continue
+                done += 1
+                _classify_over(vol[z, y, x], tstart, tinv, alpha_tab, color_tab, acc)
+                if acc[3] >= threshold:
+                    break
+            for ch in range(4):
+                out[y, x, ch] = acc[ch]
+        counts[y] = done
+
+
+@parallel_jit
+def composite_slices(vol, front_to_back, inverse2, shift, limits, tstart, tinv, alpha_tab,
+                     color_tab, threshold, out, counts):
+    """Two-pass compositing: ``vol[w, Y, X]`` holds slice ``w`` resampled onto the image's
+    rows and columns; each pixel composites the slices in view order, each a segment of the
+    same length (the table's). Sample ``(X, Y)`` of slice ``w`` belongs to the volume when
+    ``(u, v) = inverse2 @ ((X, Y) - shift[:2] - w shift[2:])`` lies within ``limits``."""
+    n_w, height, width = vol.shape
+    for row_index in prange(height):
+        y = np.int64(row_index)
+        acc = np.zeros(4)
+        done = 0
+        for x in range(width):
+            acc[:] = 0.0
+            for step in range(n_w):
+                w = step if front_to_back else n_w - 1 - step
+                dx = x - shift[0] - w * shift[2]
+                dy = y - shift[1] - w * shift[3]
+                u = inverse2[0, 0] * dx + inverse2[0, 1] * dy
+                v = inverse2[1, 0] * dx + inverse2[1, 1] * dy
+                if u < 0.0 or u > limits[0] or v < 0.0 or v > limits[1]:
+                    continue
+                done += 1
+                _classify_over(vol[w, y, x], tstart, tinv, alpha_tab, color_tab, acc)
+                if acc[3] >= threshold:
+                    break
+            for ch in range(4):
+                out[y, x, ch] = acc[ch]
+        counts[y] = done
