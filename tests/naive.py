@@ -158,3 +158,67 @@ def splat_naive(volume, view, filt, transfer, mode):
     image = np.maximum(image, 0.0)  # negative lobes: clamped to transparent black
     image[..., 3] = np.minimum(image[..., 3], 1.0)
     return image
+
+
+def shear_pass_naive(src, out_shape, c0, c1, c2, offset, filt):
+    """One 1-D resampling pass by the book: ``out[s, r, q] = sum_a k(pos - n_a) src[s, r, n_a]``
+    at ``pos = (q - offset - c1 r - c2 s) / c0``, taps clamped to the line, outputs whose source
+    lies beyond the line (and the filter's reach) zero."""
+    out = np.zeros(out_shape)
+    n = src.shape[2]
+    taps = max(1, math.ceil(2 * filt.radius))
+    for s in range(out_shape[0]):
+        for r in range(out_shape[1]):
+            for q in range(out_shape[2]):
+                pos = (q - offset - c1 * r - c2 * s) / c0
+                if not -filt.radius <= pos <= n - 1 + filt.radius:
+                    continue
+                idx = math.floor(pos - filt.radius) + 1 + np.arange(taps)
+                out[s, r, q] = np.sum(filt(pos - idx) * src[s, r, np.clip(idx, 0, n - 1)])
+    return out
+
+
+def shear_naive(volume, view, filt, transfer, step, passes):
+    """Three- (``passes=3``) or two-pass shear rendering with the kernels' plan, by the book:
+    the passes above, then each pixel's samples composited in depth order, a sample counting
+    only where it maps back inside the volume."""
+    from vrlib.shear import plan_shear
+
+    ds = step * float(volume.spacing.min())
+    plan = plan_shear(volume, view, ds)
+    u, v, w = plan.order
+    data = np.transpose(np.asarray(volume.data, float), (2 - w, 2 - v, 2 - u))
+    nw, nv, nu = data.shape
+    h, wd = view.shape
+    v1 = shear_pass_naive(data, (nw, nv, wd), plan.a, plan.b, plan.c, plan.t0, filt)
+    v2 = shear_pass_naive(v1.transpose(0, 2, 1), (nw, wd, h), plan.e, plan.d, plan.f, plan.t1,
+                          filt).transpose(0, 2, 1)
+    image = np.zeros(view.shape + (4,))
+    limits = np.array([nu, nv, nw]) - 1.0
+    if passes == 3:
+        v3 = shear_pass_naive(v2.transpose(1, 2, 0), (h, wd, plan.depth_samples), plan.i,
+                              plan.g, plan.h, plan.t2, filt).transpose(2, 0, 1)
+        inverse = np.linalg.inv(plan.matrix)
+        samples = [(z, v3[z]) for z in range(v3.shape[0])]
+        length = ds
+    else:
+        order = range(nw) if plan.i > 0 else range(nw - 1, -1, -1)
+        samples = [(z, v2[z]) for z in order]
+        length = abs(plan.i) * ds
+    rows, cols = np.mgrid[0:h, 0:wd]
+    for z, layer in samples:
+        if passes == 3:
+            pts = np.stack([cols - plan.shift[0], rows - plan.shift[1],
+                            np.full(rows.shape, z - plan.shift[2])], -1) @ inverse.T
+            inside = np.all((pts >= 0) & (pts <= limits), axis=-1)
+        else:
+            m = plan.matrix
+            rhs = np.stack([cols - plan.shift[0] - z * m[0, 2],
+                            rows - plan.shift[1] - z * m[1, 2]], -1)
+            uv = rhs @ np.linalg.inv(m[:2, :2]).T
+            inside = np.all((uv >= 0) & (uv <= limits[:2]), axis=-1)
+        alpha = -np.expm1(-transfer.opacity_density(layer) * length) * inside
+        segment = np.concatenate([transfer.emission(layer) * alpha[..., None],
+                                  alpha[..., None]], -1)
+        image = image + (1.0 - image[..., 3:4]) * segment
+    return np.clip(image, 0.0, 1.0)

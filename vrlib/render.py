@@ -11,7 +11,7 @@ import numba
 from vrlib import _validate
 from vrlib.filters import make_filter
 from vrlib.raycast import render_raycast
-from vrlib.shear import render_shear2, render_shear3
+from vrlib.shear import render_shear2, render_shear3, render_shearwarp
 from vrlib.splat import render_splat
 from vrlib.transfer import Glow, TransferFunction
 from vrlib.view import View
@@ -21,7 +21,7 @@ __all__ = ["render", "METHODS", "method_options"]
 
 #: Rendering methods by name.
 METHODS = {"raycast": render_raycast, "splat": render_splat, "shear3": render_shear3,
-           "shear2": render_shear2}
+           "shear2": render_shear2, "shearwarp": render_shearwarp}
 
 _COMMON = {"filt", "transfer", "step", "early_termination", "empty_space_skipping"}
 

@@ -31,7 +31,8 @@ from vrlib._kernels import shear as _kernel
 from vrlib.image import Image, RenderStats
 from vrlib.raycast import reconstructed_range, taps_per_axis
 
-__all__ = ["render_shear3", "render_shear2", "ShearPlan", "plan_shear"]
+__all__ = ["render_shear3", "render_shear2", "render_shearwarp", "ShearPlan", "plan_shear",
+           "transparent_bound"]
 
 
 class ShearPlan:
@@ -214,4 +215,98 @@ def render_shear2(volume, view, *, filt, transfer, step, early_termination,
     stats = _stats(volume, ntaps, count, int(counts.sum()), time.perf_counter() - start,
                    count["buffers"])
     stats.passes = count
+    return Image(np.clip(out, 0.0, 1.0), stats)
+
+
+def transparent_bound(transfer, low, high, length, min_opacity):
+    """Largest value up to which every value is transparent: its segment opacity at ``length``
+    stays at or below ``min_opacity`` (0: exactly transparent). ``-inf`` when none is.
+
+    Examples
+    --------
+    >>> from vrlib import Glow
+    >>> transparent_bound(Glow(1.0), -1.0, 1.0, 0.1, 0.0)
+    0.0
+    """
+    start, inv, density, _ = transfer.value_table(low, high)
+    alpha = -np.expm1(-density * length)
+    visible = np.flatnonzero(alpha > min_opacity)
+    if visible.size == 0:
+        return math.inf
+    if visible[0] == 0:
+        return -math.inf
+    return start + (visible[0] - 1) / inv
+
+
+def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
+                     empty_space_skipping, min_opacity=0.0):
+    """Shear-warp rendering (Lacroute and Levoy 1994; arguments validated by
+    :func:`vrlib.render`).
+
+    Slices perpendicular to the volume axis most parallel to the view are translated (sheared)
+    so that the view becomes a projection along that axis, resampled with the chosen filter
+    (in 2-D, with one set of weights per slice), composited front to back into an intermediate
+    image at the volume's resolution, and the intermediate image is warped to the final one
+    with bilinear interpolation. ``step`` is unused: the samples along a ray are the slices.
+
+    Parameters
+    ----------
+    min_opacity : float, default 0
+        Voxels whose segment opacity is at most this are transparent for run-length skipping;
+        0 skips only voxels that add nothing (exact), larger values skip faint voxels too
+        (lossy, as VolPack's threshold). Skipping is on with ``empty_space_skipping`` and for
+        filters without negative lobes.
+    """
+    from vrlib._kernels.splat import row_extents as _row_extents
+    from vrlib._validate import finite_number
+    from vrlib.skipping import lattice_sums
+    from vrlib.splat import _slice_order, major_axis
+
+    min_opacity = finite_number("min_opacity", min_opacity, low=0.0, high=1.0, high_open=True)
+    if view.is_perspective:
+        raise ValueError("shear-warp is implemented for orthographic views only so far; "
+                         "use method='raycast' for perspective")
+    ntaps = taps_per_axis(filt)
+    if ntaps > 8:
+        raise ValueError(f"filter radius {filt.radius:g} is out of range: shearing takes radii "
+                         "up to 4 voxels")
+    start = time.perf_counter()
+    axis, ascending = major_axis(volume, view)
+    p_axis, q_axis = [a for a in range(3) if a != axis]
+    slices = _slice_order(volume.data, axis)  # [k, j, i]: j along p_axis, i along q_axis
+    n_k, n_j, n_i = slices.shape
+    h = volume.spacing
+    direction = view.forward / h  # the view in index units
+    si, sj = direction[q_axis] / direction[axis], direction[p_axis] / direction[axis]
+    oi, oj = max(0.0, si * (n_k - 1)), max(0.0, sj * (n_k - 1))
+    width = math.ceil(n_i + abs(si) * (n_k - 1))
+    height = math.ceil(n_j + abs(sj) * (n_k - 1))
+    k = np.arange(n_k)
+    di, dj = -oi + si * k, -oj + sj * k
+    order = k if ascending else k[::-1].copy()
+    length = h[axis] / abs(view.forward[axis])
+    low, high = reconstructed_range(volume, filt)
+    tables = transfer.segment_table(length, low, high)
+    first = np.zeros((n_k, n_j), np.int64)
+    last = np.full((n_k, n_j), n_i - 1, np.int64)
+    if empty_space_skipping and lattice_sums(filt)[2] <= 1.0 + 1e-6:
+        bound = transparent_bound(transfer, low, high, length, min_opacity)
+        _row_extents(volume.data > bound, axis, first, last)
+    inter = np.zeros((height, width, 4))
+    counts = np.zeros(height, np.int64)
+    _kernel.shear_slices(slices, order, di, dj, *filt.code, filt.radius, ntaps, tables[0],
+                         tables[1], tables[2], tables[3], early_termination, first, last, inter,
+                         counts)
+    # The warp: where each pixel's ray meets slice 0, in intermediate coordinates.
+    origins, directions = view.rays()
+    t = (volume.origin[axis] - origins[..., axis]) / directions[..., axis]
+    points = origins + t[..., None] * directions
+    coords = np.stack([(points[..., q_axis] - volume.origin[q_axis]) / h[q_axis] + oi,
+                       (points[..., p_axis] - volume.origin[p_axis]) / h[p_axis] + oj], -1)
+    out = np.empty(view.shape + (4,))
+    _kernel.warp(inter, coords, out)
+    resampled = int(counts.sum())
+    stats = RenderStats(samples=resampled, operations=resampled * (2 * ntaps**2 + 12)
+                        + out.size * 8, bytes=int(volume.data.nbytes + inter.nbytes + out.nbytes),
+                        seconds=time.perf_counter() - start, voxels=resampled)
     return Image(np.clip(out, 0.0, 1.0), stats)

@@ -132,3 +132,94 @@ def composite_slices(vol, front_to_back, inverse2, shift, limits, tstart, tinv, 
             for ch in range(4):
                 out[y, x, ch] = acc[ch]
         counts[y] = done
+
+
+@parallel_jit
+def shear_slices(slices, order, di, dj, fkind, fp0, fp1, fp2, radius, ntaps, tstart, tinv,
+                 alpha_tab, color_tab, threshold, first, last, inter, counts):
+    """Shear-warp's compositing into the intermediate image (Lacroute and Levoy 1994).
+
+    ``slices[k, j, i]`` is the volume in slice order; slice ``k`` lands on the intermediate
+    image translated so that intermediate pixel ``(I, J)`` samples the slice at
+    ``(i, j) = (I + di[k], J + dj[k])``: one fractional offset per slice, so the filter's
+    weights are the same for every pixel of it. Slices are taken in ``order`` (front to back)
+    and composited into ``inter[J, I]`` (premultiplied RGBA). Row ``j`` of slice ``k`` holds
+    nothing visible outside columns ``first[k, j] .. last[k, j]``; pixels whose opacity has
+    reached ``threshold`` take no more. Each task owns intermediate rows: no races.
+    """
+    n_k, n_j, n_i = slices.shape
+    height, width = inter.shape[0], inter.shape[1]
+    for row in prange(height):
+        big_j = np.int64(row)
+        wi = np.empty(8)
+        wj = np.empty(8)
+        done = 0
+        for step in range(n_k):
+            k = order[step]
+            j = big_j + dj[k]
+            if j < 0.0 or j > n_j - 1:
+                continue
+            j_first = int(math.floor(j - radius)) + 1
+            for b in range(ntaps):
+                wj[b] = weight(fkind, fp0, fp1, fp2, j - (j_first + b))
+            # Columns this row can draw: the union of the tap rows' visible runs, widened.
+            lo = n_i
+            hi = -1
+            for b in range(ntaps):
+                jj = _clamp(j_first + b, n_j)
+                if first[k, jj] <= last[k, jj]:
+                    lo = min(lo, first[k, jj])
+                    hi = max(hi, last[k, jj])
+            if lo > hi:
+                continue
+            frac_first = int(math.floor(di[k] - radius)) + 1  # tap offset of I = 0
+            for a in range(ntaps):
+                wi[a] = weight(fkind, fp0, fp1, fp2, di[k] - (frac_first + a))
+            i_lo = -di[k]  # intermediate columns whose sample lies in the slice
+            i_hi = n_i - 1.0 - di[k]
+            big_first = max(int(math.ceil(i_lo)), int(math.floor(lo - radius - di[k])))
+            big_last = min(int(math.floor(i_hi)), int(math.ceil(hi + radius - di[k])), width - 1)
+            for big_i in range(max(big_first, 0), big_last + 1):
+                if inter[big_j, big_i, 3] >= threshold:
+                    continue
+                value = 0.0
+                for b in range(ntaps):
+                    jj = _clamp(j_first + b, n_j)
+                    line = 0.0
+                    for a in range(ntaps):
+                        line += wi[a] * slices[k, jj, _clamp(big_i + frac_first + a, n_i)]
+                    value += wj[b] * line
+                done += 1
+                i, w = _lookup((value - tstart) * tinv, alpha_tab.shape[0])
+                alpha = alpha_tab[i] + w * (alpha_tab[i + 1] - alpha_tab[i])
+                if alpha > 0.0:
+                    remaining = 1.0 - inter[big_j, big_i, 3]
+                    for ch in range(3):
+                        inter[big_j, big_i, ch] += remaining * (
+                            color_tab[i, ch] + w * (color_tab[i + 1, ch] - color_tab[i, ch]))
+                    inter[big_j, big_i, 3] += remaining * alpha
+        counts[big_j] = done
+
+
+@parallel_jit
+def warp(inter, coords, out):
+    """The 2-D warp: ``out[r, c]`` is ``inter`` sampled bilinearly at ``coords[r, c] = (I, J)``
+    (transparent outside)."""
+    height, width = out.shape[0], out.shape[1]
+    n_j, n_i = inter.shape[0], inter.shape[1]
+    for row in prange(height):
+        for c in range(width):
+            x = coords[row, c, 0]
+            y = coords[row, c, 1]
+            for ch in range(4):
+                out[row, c, ch] = 0.0
+            if not (x >= 0.0 and y >= 0.0 and x <= n_i - 1 and y <= n_j - 1):
+                continue
+            i = min(int(x), n_i - 2)
+            j = min(int(y), n_j - 2)
+            tx = x - i
+            ty = y - j
+            for ch in range(4):
+                out[row, c, ch] = ((1 - ty) * ((1 - tx) * inter[j, i, ch] + tx * inter[j, i + 1, ch])
+                                   + ty * ((1 - tx) * inter[j + 1, i, ch]
+                                           + tx * inter[j + 1, i + 1, ch]))
