@@ -204,7 +204,7 @@ def shear_naive(volume, view, filt, transfer, step, passes):
     else:
         order = range(nw) if plan.i > 0 else range(nw - 1, -1, -1)
         samples = [(z, v2[z]) for z in order]
-        length = abs(plan.i) * ds
+        length = abs(plan.i) * ds  # half that for the end slices (below)
     rows, cols = np.mgrid[0:h, 0:wd]
     for z, layer in samples:
         if passes == 3:
@@ -217,8 +217,65 @@ def shear_naive(volume, view, filt, transfer, step, passes):
                             rows - plan.shift[1] - z * m[1, 2]], -1)
             uv = rhs @ np.linalg.inv(m[:2, :2]).T
             inside = np.all((uv >= 0) & (uv <= limits[:2]), axis=-1)
-        alpha = -np.expm1(-transfer.opacity_density(layer) * length) * inside
+        end = passes == 2 and z in (0, nw - 1)  # end slices reach half a spacing in
+        alpha = -np.expm1(-transfer.opacity_density(layer) * length * (0.5 if end else 1.0))
+        alpha = alpha * inside
         segment = np.concatenate([transfer.emission(layer) * alpha[..., None],
                                   alpha[..., None]], -1)
         image = image + (1.0 - image[..., 3:4]) * segment
     return np.clip(image, 0.0, 1.0)
+
+
+def shearwarp_naive(volume, view, filt, transfer):
+    """Shear-warp by the book: each slice resampled onto the intermediate image with the
+    filter at its fractional offset, composited front to back, then the intermediate image
+    sampled bilinearly where each pixel's ray meets slice 0."""
+    from vrlib.splat import major_axis
+
+    axis, ascending = major_axis(volume, view)
+    p_axis, q_axis = [a for a in range(3) if a != axis]
+    slices = np.transpose(np.asarray(volume.data, float),
+                          (2 - axis, 2 - p_axis, 2 - q_axis))
+    n_k, n_j, n_i = slices.shape
+    h = volume.spacing
+    direction = view.forward / h
+    si, sj = direction[q_axis] / direction[axis], direction[p_axis] / direction[axis]
+    oi, oj = max(0.0, si * (n_k - 1)), max(0.0, sj * (n_k - 1))
+    width = math.ceil(n_i + abs(si) * (n_k - 1))
+    height = math.ceil(n_j + abs(sj) * (n_k - 1))
+    length = h[axis] / abs(view.forward[axis])
+    inter = np.zeros((height, width, 4))
+    taps = max(1, math.ceil(2 * filt.radius))
+    for k in (range(n_k) if ascending else range(n_k - 1, -1, -1)):
+        for big_j in range(height):
+            j = big_j - oj + sj * k
+            if not 0 <= j <= n_j - 1:
+                continue
+            jdx = math.floor(j - filt.radius) + 1 + np.arange(taps)
+            for big_i in range(width):
+                i = big_i - oi + si * k
+                if not 0 <= i <= n_i - 1:
+                    continue
+                idx = math.floor(i - filt.radius) + 1 + np.arange(taps)
+                patch = slices[k][np.ix_(np.clip(jdx, 0, n_j - 1), np.clip(idx, 0, n_i - 1))]
+                value = filt(j - jdx) @ patch @ filt(i - idx)
+                part = 0.5 if k in (0, n_k - 1) else 1.0  # end slices reach half as far
+                alpha = -np.expm1(-transfer.opacity_density(np.array([value]))[0] * length
+                                  * part)
+                colour = transfer.emission(np.array([value]))[0]
+                inter[big_j, big_i] += (1 - inter[big_j, big_i, 3]) * np.r_[colour * alpha,
+                                                                              alpha]
+    origins, directions = view.rays()
+    t = (volume.origin[axis] - origins[..., axis]) / directions[..., axis]
+    points = origins + t[..., None] * directions
+    x = (points[..., q_axis] - volume.origin[q_axis]) / h[q_axis] + oi
+    y = (points[..., p_axis] - volume.origin[p_axis]) / h[p_axis] + oj
+    out = np.zeros(view.shape + (4,))
+    inside = (x >= 0) & (y >= 0) & (x <= width - 1) & (y <= height - 1)
+    i0 = np.clip(np.floor(x).astype(int), 0, width - 2)
+    j0 = np.clip(np.floor(y).astype(int), 0, height - 2)
+    tx, ty = (x - i0)[..., None], (y - j0)[..., None]
+    sample = ((1 - ty) * ((1 - tx) * inter[j0, i0] + tx * inter[j0, i0 + 1])
+              + ty * ((1 - tx) * inter[j0 + 1, i0] + tx * inter[j0 + 1, i0 + 1]))
+    out[inside] = sample[inside]
+    return np.clip(out, 0.0, 1.0)

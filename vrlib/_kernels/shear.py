@@ -59,16 +59,23 @@ def shear_pass(src, out, c0, c1, c2, offset, fkind, fp0, fp1, fp2, radius, ntaps
 
 
 @jit
-def _classify_over(value, tstart, tinv, alpha_tab, color_tab, acc):
+def _classify_over(value, tstart, tinv, alpha_tab, color_tab, acc, half):
     """Classify one sample from the segment table and composite it under ``acc`` (eqs 1.7-1.8,
-    colour E alpha: eq 1.9)."""
+    colour E alpha: eq 1.9). With ``half`` the segment is half the table's length: the first
+    and last slices of a volume reach only half a slice spacing into it, and
+    ``1 - alpha_half = sqrt(1 - alpha)``."""
     i, w = _lookup((value - tstart) * tinv, alpha_tab.shape[0])
     alpha = alpha_tab[i] + w * (alpha_tab[i + 1] - alpha_tab[i])
     if alpha > 0.0:
+        scale = 1.0
+        if half:
+            shorter = 1.0 - math.sqrt(1.0 - alpha)
+            scale = shorter / alpha
+            alpha = shorter
         remaining = 1.0 - acc[3]
         for ch in range(3):
-            acc[ch] += remaining * (color_tab[i, ch] + w * (color_tab[i + 1, ch]
-                                                              - color_tab[i, ch]))
+            acc[ch] += remaining * scale * (color_tab[i, ch] + w * (color_tab[i + 1, ch]
+                                                                      - color_tab[i, ch]))
         acc[3] += remaining * alpha
 
 
@@ -95,7 +102,7 @@ def composite_lattice(vol, inverse, shift, limits, tstart, tinv, alpha_tab, colo
                 if not inside:
                     continue
                 done += 1
-                _classify_over(vol[z, y, x], tstart, tinv, alpha_tab, color_tab, acc)
+                _classify_over(vol[z, y, x], tstart, tinv, alpha_tab, color_tab, acc, False)
                 if acc[3] >= threshold:
                     break
             for ch in range(4):
@@ -108,7 +115,8 @@ def composite_slices(vol, front_to_back, inverse2, shift, limits, tstart, tinv, 
                      color_tab, threshold, out, counts):
     """Two-pass compositing: ``vol[w, Y, X]`` holds slice ``w`` resampled onto the image's
     rows and columns; each pixel composites the slices in view order, each a segment of the
-    same length (the table's). Sample ``(X, Y)`` of slice ``w`` belongs to the volume when
+    same length (the table's) but the first and last, which reach half as far into the volume.
+    Sample ``(X, Y)`` of slice ``w`` belongs to the volume when
     ``(u, v) = inverse2 @ ((X, Y) - shift[:2] - w shift[2:])`` lies within ``limits``."""
     n_w, height, width = vol.shape
     for row_index in prange(height):
@@ -126,7 +134,8 @@ def composite_slices(vol, front_to_back, inverse2, shift, limits, tstart, tinv, 
                 if u < 0.0 or u > limits[0] or v < 0.0 or v > limits[1]:
                     continue
                 done += 1
-                _classify_over(vol[w, y, x], tstart, tinv, alpha_tab, color_tab, acc)
+                _classify_over(vol[w, y, x], tstart, tinv, alpha_tab, color_tab, acc,
+                               w == 0 or w == n_w - 1)
                 if acc[3] >= threshold:
                     break
             for ch in range(4):
@@ -143,7 +152,8 @@ def shear_slices(slices, order, di, dj, fkind, fp0, fp1, fp2, radius, ntaps, tst
     image translated so that intermediate pixel ``(I, J)`` samples the slice at
     ``(i, j) = (I + di[k], J + dj[k])``: one fractional offset per slice, so the filter's
     weights are the same for every pixel of it. Slices are taken in ``order`` (front to back)
-    and composited into ``inter[J, I]`` (premultiplied RGBA). Row ``j`` of slice ``k`` holds
+    and composited into ``inter[J, I]`` (premultiplied RGBA), each a segment of the table's
+    length but the first and last, half as long. Row ``j`` of slice ``k`` holds
     nothing visible outside columns ``first[k, j] .. last[k, j]``; pixels whose opacity has
     reached ``threshold`` take no more. Each task owns intermediate rows: no races.
     """
@@ -190,14 +200,8 @@ def shear_slices(slices, order, di, dj, fkind, fp0, fp1, fp2, radius, ntaps, tst
                         line += wi[a] * slices[k, jj, _clamp(big_i + frac_first + a, n_i)]
                     value += wj[b] * line
                 done += 1
-                i, w = _lookup((value - tstart) * tinv, alpha_tab.shape[0])
-                alpha = alpha_tab[i] + w * (alpha_tab[i + 1] - alpha_tab[i])
-                if alpha > 0.0:
-                    remaining = 1.0 - inter[big_j, big_i, 3]
-                    for ch in range(3):
-                        inter[big_j, big_i, ch] += remaining * (
-                            color_tab[i, ch] + w * (color_tab[i + 1, ch] - color_tab[i, ch]))
-                    inter[big_j, big_i, 3] += remaining * alpha
+                _classify_over(value, tstart, tinv, alpha_tab, color_tab, inter[big_j, big_i],
+                               k == 0 or k == n_k - 1)
         counts[big_j] = done
 
 
@@ -220,6 +224,6 @@ def warp(inter, coords, out):
             tx = x - i
             ty = y - j
             for ch in range(4):
-                out[row, c, ch] = ((1 - ty) * ((1 - tx) * inter[j, i, ch] + tx * inter[j, i + 1, ch])
-                                   + ty * ((1 - tx) * inter[j + 1, i, ch]
-                                           + tx * inter[j + 1, i + 1, ch]))
+                top = (1 - tx) * inter[j, i, ch] + tx * inter[j, i + 1, ch]
+                bottom = (1 - tx) * inter[j + 1, i, ch] + tx * inter[j + 1, i + 1, ch]
+                out[row, c, ch] = (1 - ty) * top + ty * bottom

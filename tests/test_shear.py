@@ -1,0 +1,203 @@
+"""Volume shearing: three-pass, two-pass and shear-warp against their twins and the truth."""
+
+import numba
+import numpy as np
+import pytest
+from naive import (
+    exact_blob_image,
+    image_mass,
+    random_orbits,
+    shear_naive,
+    shearwarp_naive,
+)
+
+import data_gen
+import vrlib
+from vrlib import Glow, LookupTransfer, View, Volume, metrics, render
+from vrlib.shear import plan_shear
+
+TABLE = LookupTransfer([0.0, 3.0, 1.0, 5.0], [[1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 1]])
+FILTERS = ["box", "trilinear", "catmull-rom", "gaussian"]
+METHODS = ["shear3", "shear2", "shearwarp"]
+
+
+def small_volume():
+    return data_gen.make_field("random-blobs", count=4, seed=2).sample((5, 6, 7))
+
+
+@pytest.mark.parametrize("filt", FILTERS)
+@pytest.mark.parametrize("transfer", [Glow(3.0), TABLE], ids=["glow", "table"])
+@pytest.mark.parametrize("method", ["shear3", "shear2"])
+def test_passes_match_naive_twin(filt, transfer, method):
+    """The pass and compositing kernels follow the plan by the book. The intermediate volumes
+    are float32: measured differences up to 8e-7, hence the 2e-6 bound."""
+    vol = small_volume()
+    view = View.orbit(azimuth=33, elevation=-21, size=(7, 9))
+    fast = render(vol, view, method=method, filter=filt, transfer=transfer, step=0.6,
+                  early_termination=1.0)
+    slow = shear_naive(vol, view, vrlib.make_filter(filt), transfer, 0.6,
+                       3 if method == "shear3" else 2)
+    np.testing.assert_allclose(fast.rgba, slow, atol=2e-6)
+    assert fast.alpha.max() > 0.2
+
+
+@pytest.mark.parametrize("filt", FILTERS)
+@pytest.mark.parametrize("transfer", [Glow(3.0), TABLE], ids=["glow", "table"])
+@pytest.mark.parametrize("azimuth, elevation", [(33, -21), (120, 50), (-60, 10)])
+def test_shearwarp_matches_naive_twin(filt, transfer, azimuth, elevation):
+    vol = small_volume()
+    view = View.orbit(azimuth=azimuth, elevation=elevation, size=(7, 9))
+    fast = render(vol, view, method="shearwarp", filter=filt, transfer=transfer,
+                  early_termination=1.0)
+    slow = shearwarp_naive(vol, view, vrlib.make_filter(filt), transfer)
+    np.testing.assert_allclose(fast.rgba, slow, atol=1e-6)
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_bit_identical_for_one_and_two_threads(method):
+    if numba.config.NUMBA_NUM_THREADS < 2:
+        pytest.skip("numba sees a single CPU: nothing to compare")
+    vol = data_gen.make_field("marschner-lobb").sample(24)
+    view = View.orbit(azimuth=20, elevation=35, size=50)
+    one = render(vol, view, method=method, filter="catmull-rom", threads=1)
+    two = render(vol, view, method=method, filter="catmull-rom", threads=2)
+    assert np.array_equal(one.rgba, two.rgba)
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_glow_blob_against_closed_form(method):
+    """Gaussian blob at 64^3, 96^2, Glow(2), step 1, over five views including a steep one.
+    Measured worst rmse (trilinear / Catmull-Rom): shear3 1.4e-4 / 3.5e-5, shear2 1.4e-4 /
+    3.3e-5, shear-warp 3.0e-4 / 2.1e-4 (its intermediate image at voxel resolution and the
+    bilinear warp blur the image once more)."""
+    field = data_gen.make_field("gaussian-blob", sigma=0.3, center=(0.05, -0.1, 0.08))
+    vol = field.sample(64)
+    for azimuth, elevation in [(30, 20), (0, 0), (45, 0), (10, 80), (-120, -30)]:
+        view = View.orbit(azimuth=azimuth, elevation=elevation, size=96)
+        exact = exact_blob_image(field, view, 2.0)
+        for filt in ("trilinear", "catmull-rom"):
+            img = render(vol, view, method=method, filter=filt, transfer=Glow(2.0), step=1.0)
+            assert metrics.rmse(img.alpha, exact) < (5e-4 if method == "shearwarp" else 2e-4)
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_mass_invariant_over_random_orbits(method):
+    """Brief section 2, to 1%, 8 random orbits."""
+    field = data_gen.make_field("gaussian-blob", sigma=0.25, center=(0.1, 0.0, -0.1))
+    vol = field.sample(48)
+    expected = 1.5 * field.integral(field.bounds)
+    for view in random_orbits(8, seed=11, size=80):
+        img = render(vol, view, method=method, transfer=Glow(1.5), step=1.0)
+        assert image_mass(img, view) == pytest.approx(expected, rel=1e-2)
+
+
+def test_two_pass_is_as_accurate_as_three_pass():
+    """Dropping the third pass costs no accuracy: on Marschner-Lobb (41^3, Catmull-Rom, step 1)
+    the two-pass image is as close to the reference as the three-pass one (measured rmse,
+    three / two: 0.0058 / 0.0054, 0.0047 / 0.0042, 0.0059 / 0.0062 at the three views).
+
+    The issue's stricter wording, that the two-pass image differs from the three-pass one by no
+    more than the three-pass one differs from the reference, does not hold: their errors are
+    of the same size and independent (the methods sample different points along each ray:
+    slices against the ray lattice), so the two images differ by about sqrt(2) times either
+    error (measured 0.0072, 0.0052, 0.0080). The test checks what is true: the two-pass error
+    is within 10% of the three-pass error, and the two images differ by at most the sum of
+    their errors.
+    """
+    field = data_gen.make_field("marschner-lobb")
+    vol = field.sample(41)
+    for azimuth, elevation in [(20, 30), (-70, 10), (140, -45)]:
+        view = View.orbit(azimuth=azimuth, elevation=elevation, size=48)
+        ref = vrlib.render_reference(field, view, tol=1e-5)
+        three = render(vol, view, method="shear3", filter="catmull-rom", step=1.0)
+        two = render(vol, view, method="shear2", filter="catmull-rom", step=1.0)
+        e3, e2 = metrics.rmse(three, ref), metrics.rmse(two, ref)
+        assert e2 < 1.1 * e3
+        assert metrics.rmse(two, three) <= e2 + e3
+
+
+def test_two_pass_resamples_fewer_samples():
+    """At one sample per voxel along the rays, pass 3 resamples about a volume's worth of
+    samples that the two-pass method never computes."""
+    vol = data_gen.make_field("marschner-lobb").sample(32)
+    view = View.orbit(azimuth=25, elevation=40, size=56)
+    three = render(vol, view, method="shear3", step=1.0).stats
+    two = render(vol, view, method="shear2", step=1.0).stats
+    assert two.passes["pass1"] == three.passes["pass1"]
+    assert two.passes["pass2"] == three.passes["pass2"]
+    assert two.voxels < 0.75 * three.voxels
+
+
+def test_shearwarp_run_skipping_and_termination():
+    """Skipping rows' transparent ends (threshold 0) changes nothing; early termination
+    changes no channel by more than 1 - threshold."""
+    data = data_gen.make_field("random-blobs", count=3, seed=5, sigma=(0.05, 0.08)).sample(
+        32).data.copy()
+    data[data < 0.05] = 0.0
+    vol = Volume(data)
+    view = View.orbit(azimuth=40, elevation=25, size=40)
+    skipped = render(vol, view, method="shearwarp", transfer=Glow(2.0))
+    full = render(vol, view, method="shearwarp", transfer=Glow(2.0), empty_space_skipping=False)
+    assert np.array_equal(skipped.rgba, full.rgba)
+    assert skipped.stats.samples < 0.5 * full.stats.samples
+    solid = data_gen.make_field("smooth-sphere", radius=0.7).sample(24)
+    opaque = render(solid, view, method="shearwarp", transfer=Glow(40.0),
+                    early_termination=1.0)
+    for threshold in (0.9, 0.99):
+        early = render(solid, view, method="shearwarp", transfer=Glow(40.0),
+                       early_termination=threshold)
+        assert np.abs(early.rgba - opaque.rgba).max() <= 1.0 - threshold + 1e-12
+        assert early.stats.samples < opaque.stats.samples
+
+
+@pytest.mark.parametrize("method", METHODS)
+@pytest.mark.parametrize("azimuth, elevation", [(0, 0), (90, 0), (0, 90), (45, 0),
+                                                (45, 35.264), (-135, -45)])
+def test_axis_aligned_tied_and_flipping_views(method, azimuth, elevation):
+    """Views along an axis, exactly between axes (where the principal axis flips between
+    nearby frames): the image a hair to either side differs only by the method's own error."""
+    vol = data_gen.make_field("gaussian-blob", sigma=0.3).sample(32)
+    images = [render(vol, View.orbit(azimuth=azimuth + da, elevation=elevation + de, size=40),
+                     method=method, step=1.0)
+              for da, de in [(0, 0), (1e-6, -1e-6), (-1e-6, 1e-6)]]
+    for img in images:
+        assert np.all(np.isfinite(img.rgba))
+    assert metrics.max_abs_error(images[1], images[2]) < 5e-3
+
+
+def test_plan_avoids_bottlenecks():
+    """The third pass runs along the axis most parallel to the view; the scale factors of the
+    first two passes stay away from zero for every view."""
+    vol = Volume(np.zeros((8, 8, 8)))
+    for view in random_orbits(40, seed=3, size=16):
+        plan = plan_shear(vol, view, 0.1)
+        assert plan.order[2] == int(np.argmax(np.abs(view.forward)))
+        assert min(abs(plan.a), abs(plan.e)) > 0.4 / view.pixel_size * vol.spacing[0]
+
+
+@pytest.mark.parametrize(
+    "method, kwargs, error, message",
+    [
+        ("shear3", {}, ValueError, "orthographic only"),
+        ("shear2", {}, ValueError, "orthographic only"),
+        ("shearwarp", {}, ValueError, "orthographic views only so far"),
+    ],
+)
+def test_perspective_is_refused_clearly(method, kwargs, error, message):
+    view = View.orbit(size=8, projection="perspective")
+    with pytest.raises(error, match=message):
+        render(small_volume(), view, method=method, **kwargs)
+
+
+@pytest.mark.parametrize(
+    "method, kwargs, error, message",
+    [
+        ("shearwarp", {"min_opacity": 1.0}, ValueError, "min_opacity must be < 1"),
+        ("shearwarp", {"min_opacity": -0.1}, ValueError, "min_opacity must be >= 0"),
+        ("shear3", {"min_opacity": 0.1}, TypeError, "method 'shear3' takes no option"),
+        ("shear2", {"filter": ("gaussian", 0.5, 6.0)}, ValueError, "radius 6 is out of range"),
+    ],
+)
+def test_bad_input(method, kwargs, error, message):
+    with pytest.raises(error, match=message):
+        render(small_volume(), View.orbit(size=8), method=method, **kwargs)
