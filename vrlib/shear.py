@@ -235,7 +235,7 @@ def transparent_bound(transfer, low, high, length, min_opacity):
         return math.inf
     if visible[0] == 0:
         return -math.inf
-    return start + (visible[0] - 1) / inv
+    return float(start + (visible[0] - 1) / inv)
 
 
 def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
