@@ -47,8 +47,10 @@ $(INSTALLED): pyproject.toml constraints.txt
 
 results: $(RESULTS)
 
-# run_* scripts compute and write build/results/<chapter>/...
-build/stamps/%.done: chapters/%.py $(LIBRARY) $(CHAPTER_COMMON) $(INSTALLED)
+# run_* scripts compute and write build/results/<chapter>/...; chapters/<chapter>/_*.py are
+# helpers shared by a chapter's scripts.
+build/stamps/%.done: chapters/%.py $(LIBRARY) $(CHAPTER_COMMON) $(INSTALLED) \
+		$$(wildcard chapters/$$(dir $$*)_*.py)
 	@mkdir -p $(@D)
 	@echo "[chapters] $*"
 	$(PY) -m chapters.$(subst /,.,$*)

@@ -160,22 +160,28 @@ def splat_naive(volume, view, filt, transfer, mode):
     return image
 
 
-def shear_pass_naive(src, out_shape, c0, c1, c2, offset, filt):
+def shear_pass_naive(src, valid, out_shape, c0, c1, c2, offset, filt):
     """One 1-D resampling pass by the book: ``out[s, r, q] = sum_a k(pos - n_a) src[s, r, n_a]``
-    at ``pos = (q - offset - c1 r - c2 s) / c0``, taps clamped to the line, outputs whose source
-    lies beyond the line (and the filter's reach) zero."""
+    at ``pos = (q - offset - c1 r - c2 s) / c0``. Each source line holds data where ``valid``
+    (what the earlier pass computed): taps are clamped to that run and outputs whose source lies
+    beyond it (and the filter's reach) stay zero. Returns the output and its validity."""
     out = np.zeros(out_shape)
-    n = src.shape[2]
+    computed = np.zeros(out_shape, dtype=bool)
     taps = max(1, math.ceil(2 * filt.radius))
     for s in range(out_shape[0]):
         for r in range(out_shape[1]):
+            where = np.flatnonzero(valid[s, r])
+            if where.size == 0:
+                continue
+            lo, hi = where[0], where[-1]
             for q in range(out_shape[2]):
                 pos = (q - offset - c1 * r - c2 * s) / c0
-                if not -filt.radius <= pos <= n - 1 + filt.radius:
+                if not lo - filt.radius <= pos <= hi + filt.radius:
                     continue
                 idx = math.floor(pos - filt.radius) + 1 + np.arange(taps)
-                out[s, r, q] = np.sum(filt(pos - idx) * src[s, r, np.clip(idx, 0, n - 1)])
-    return out
+                out[s, r, q] = np.sum(filt(pos - idx) * src[s, r, np.clip(idx, lo, hi)])
+                computed[s, r, q] = True
+    return out, computed
 
 
 def shear_naive(volume, view, filt, transfer, step, passes):
@@ -190,14 +196,18 @@ def shear_naive(volume, view, filt, transfer, step, passes):
     data = np.transpose(np.asarray(volume.data, float), (2 - w, 2 - v, 2 - u))
     nw, nv, nu = data.shape
     h, wd = view.shape
-    v1 = shear_pass_naive(data, (nw, nv, wd), plan.a, plan.b, plan.c, plan.t0, filt)
-    v2 = shear_pass_naive(v1.transpose(0, 2, 1), (nw, wd, h), plan.e, plan.d, plan.f, plan.t1,
-                          filt).transpose(0, 2, 1)
+    v1, ok1 = shear_pass_naive(data, np.ones(data.shape, bool), (nw, nv, wd), plan.a, plan.b,
+                               plan.c, plan.t0, filt)
+    v2, ok2 = shear_pass_naive(v1.transpose(0, 2, 1), ok1.transpose(0, 2, 1), (nw, wd, h),
+                               plan.e, plan.d, plan.f, plan.t1, filt)
+    v2, ok2 = v2.transpose(0, 2, 1), ok2.transpose(0, 2, 1)
     image = np.zeros(view.shape + (4,))
     limits = np.array([nu, nv, nw]) - 1.0
     if passes == 3:
-        v3 = shear_pass_naive(v2.transpose(1, 2, 0), (h, wd, plan.depth_samples), plan.i,
-                              plan.g, plan.h, plan.t2, filt).transpose(2, 0, 1)
+        v3, _ = shear_pass_naive(v2.transpose(1, 2, 0), ok2.transpose(1, 2, 0),
+                                 (h, wd, plan.depth_samples), plan.i, plan.g, plan.h, plan.t2,
+                                 filt)
+        v3 = v3.transpose(2, 0, 1)
         inverse = np.linalg.inv(plan.matrix)
         samples = [(z, v3[z]) for z in range(v3.shape[0])]
         length = ds

@@ -60,7 +60,7 @@ def render(volume, view, *, method="raycast", filter="trilinear", transfer=None,
     ----------
     volume : Volume
     view : View
-    method : {"raycast", "splat"}
+    method : {"raycast", "splat", "shear3", "shear2", "shearwarp"}
         The rendering method (see :data:`METHODS`).
     filter : str, tuple or Filter, default "trilinear"
         Reconstruction filter, by name or built with :func:`vrlib.make_filter`.
@@ -79,7 +79,8 @@ def render(volume, view, *, method="raycast", filter="trilinear", transfer=None,
         Threads to use (default: numba's setting). The image does not depend on it.
     **options
         Options of the chosen method (:func:`method_options` lists them): for ``"splat"``,
-        ``mode`` ("sheet" or "direct") and ``footprint_resolution``.
+        ``mode`` ("sheet" or "direct") and ``footprint_resolution``; for ``"shearwarp"``,
+        ``min_opacity``.
 
     Returns
     -------

@@ -137,24 +137,50 @@ def _check(view, filt):
     return ntaps
 
 
+def _filled(first, last, length):
+    """For the next pass: each of its lines runs across the lines of this pass, and holds data
+    where this pass computed it. ``first[s, r] .. last[s, r]`` are the outputs this pass
+    computed on line ``(s, r)``; returns, for every ``(s, q)`` with ``q`` in ``[0, length)``,
+    the first and last ``r`` whose range covers ``q`` (``first > last`` where none does)."""
+    q = np.arange(length)
+    covered = (first[:, :, None] <= q) & (q <= last[:, :, None])  # [s, r, q]
+    any_r = covered.any(axis=1)
+    n_r = first.shape[1]
+    lo = np.where(any_r, covered.argmax(axis=1), n_r)
+    hi = np.where(any_r, n_r - 1 - covered[:, ::-1, :].argmax(axis=1), -1)
+    return lo.astype(np.int64), hi.astype(np.int64)
+
+
+def _run_pass(src, out, c0, c1, c2, offset, lo, hi, filt, ntaps):
+    counts = np.zeros(out.shape[0], np.int64)
+    first = np.empty(out.shape[:2], np.int64)
+    last = np.empty(out.shape[:2], np.int64)
+    _kernel.shear_pass(src, out, c0, c1, c2, offset, lo, hi, *filt.code, filt.radius, ntaps,
+                       counts, first, last)
+    return int(counts.sum()), first, last
+
+
 def _passes(volume, view, plan, filt, ntaps, count):
-    """Passes 1 and 2; returns ``V2[w, Y, X]`` and the samples resampled by each pass."""
+    """Passes 1 and 2; returns ``V2[w, Y, X]`` and the computed output ranges of pass 2.
+
+    Each pass computes only outputs the volume reaches: a line of pass 2 holds data where pass 1
+    computed it, and so on.
+    """
     u, v, w = plan.order
     data = np.transpose(volume.data, (2 - w, 2 - v, 2 - u))  # [w, v, u], a view
-    nw, nv = data.shape[:2]
-    code = (*filt.code, filt.radius, ntaps)
+    nw, nv, nu = data.shape
     v1 = np.zeros((nw, nv, view.width), np.float32)
-    counts1 = np.zeros(nw, np.int64)
-    _kernel.shear_pass(data, v1, plan.a, plan.b, plan.c, plan.t0, *code, counts1)
+    count["pass1"], first1, last1 = _run_pass(
+        data, v1, plan.a, plan.b, plan.c, plan.t0, np.zeros((nw, nv), np.int64),
+        np.full((nw, nv), nu - 1, np.int64), filt, ntaps)
+    lo, hi = _filled(first1, last1, view.width)  # pass 2 lines (w, X) run along v
     v2 = np.zeros((nw, view.height, view.width), np.float32)
-    counts2 = np.zeros(nw, np.int64)
-    _kernel.shear_pass(v1.transpose(0, 2, 1), v2.transpose(0, 2, 1), plan.e, plan.d, plan.f,
-                       plan.t1, *code, counts2)
-    count["pass1"] = int(counts1.sum())
-    count["pass2"] = int(counts2.sum())
+    count["pass2"], first2, last2 = _run_pass(
+        v1.transpose(0, 2, 1), v2.transpose(0, 2, 1), plan.e, plan.d, plan.f, plan.t1, lo, hi,
+        filt, ntaps)
     count["buffers"] = v1.nbytes + v2.nbytes
     del v1
-    return v2
+    return v2, first2, last2
 
 
 def _stats(volume, taps, count, composited, seconds, largest):
@@ -172,12 +198,13 @@ def render_shear3(volume, view, *, filt, transfer, step, early_termination,
     ds = step * float(volume.spacing.min())
     plan = plan_shear(volume, view, ds)
     count = {}
-    v2 = _passes(volume, view, plan, filt, ntaps, count)
+    v2, first2, last2 = _passes(volume, view, plan, filt, ntaps, count)
     v3 = np.zeros((plan.depth_samples, view.height, view.width), np.float32)
-    counts3 = np.zeros(view.height, np.int64)
-    _kernel.shear_pass(v2.transpose(1, 2, 0), v3.transpose(1, 2, 0), plan.i, plan.g, plan.h,
-                       plan.t2, *filt.code, filt.radius, ntaps, counts3)
-    count["pass3"] = int(counts3.sum())
+    # Pass 3 lines (Y, X) run along w: first2/last2 are indexed [w, X] over Y.
+    lo, hi = _filled(first2.transpose(1, 0), last2.transpose(1, 0), view.height)  # [X, Y]
+    count["pass3"], _, _ = _run_pass(
+        v2.transpose(1, 2, 0), v3.transpose(1, 2, 0), plan.i, plan.g, plan.h, plan.t2,
+        np.ascontiguousarray(lo.T), np.ascontiguousarray(hi.T), filt, ntaps)
     largest = max(count["buffers"], v2.nbytes + v3.nbytes)
     del v2
     tables = transfer.segment_table(ds, *reconstructed_range(volume, filt))
@@ -201,7 +228,7 @@ def render_shear2(volume, view, *, filt, transfer, step, early_termination,
     ds = step * float(volume.spacing.min())
     plan = plan_shear(volume, view, ds)
     count = {}
-    v2 = _passes(volume, view, plan, filt, ntaps, count)
+    v2, _, _ = _passes(volume, view, plan, filt, ntaps, count)
     length = abs(plan.i) * ds  # world distance between slices along a ray
     tables = transfer.segment_table(length, *reconstructed_range(volume, filt))
     m = plan.matrix

@@ -30,29 +30,42 @@ def _clamp(i, n):
 
 
 @parallel_jit
-def shear_pass(src, out, c0, c1, c2, offset, fkind, fp0, fp1, fp2, radius, ntaps, counts):
+def shear_pass(src, out, c0, c1, c2, offset, line_lo, line_hi, fkind, fp0, fp1, fp2, radius,
+               ntaps, counts, out_first, out_last):
     """One resampling pass (see the module docstring); ``counts[s]`` gets the outputs computed
-    for outer index ``s``."""
+    for outer index ``s``.
+
+    Source line ``(s, r)`` holds data only on ``line_lo[s, r] .. line_hi[s, r]`` (the part an
+    earlier pass filled); taps are clamped to it, and only outputs whose source lies within it,
+    widened by the filter's reach, are computed: ``out_first[s, r] .. out_last[s, r]``.
+    """
     n_s, n_r, n_q = out.shape
     n = src.shape[2]
-    reach = radius
     for s_index in prange(n_s):
         s = np.int64(s_index)
         done = 0
         for r in range(n_r):
+            out_first[s, r] = 0
+            out_last[s, r] = -1
+            lo = max(0, line_lo[s, r])
+            hi = min(n - 1, line_hi[s, r])
+            if lo > hi:
+                continue
             base = offset + c1 * r + c2 * s
-            # Output positions q = base + c0 pos whose source pos lies in [-reach, n-1+reach].
-            q_a = base - c0 * reach
-            q_b = base + c0 * (n - 1 + reach)
+            # Output positions q = base + c0 pos whose source lies in [lo - reach, hi + reach].
+            q_a = base + c0 * (lo - radius)
+            q_b = base + c0 * (hi + radius)
             q_first = max(0, int(math.ceil(min(q_a, q_b))))
             q_last = min(n_q - 1, int(math.floor(max(q_a, q_b))))
+            out_first[s, r] = q_first
+            out_last[s, r] = q_last
             for q in range(q_first, q_last + 1):
                 pos = (q - base) / c0
                 first = int(math.floor(pos - radius)) + 1
                 acc = 0.0
                 for a in range(ntaps):
-                    acc += weight(fkind, fp0, fp1, fp2, pos - (first + a)) * src[
-                        s, r, _clamp(first + a, n)]
+                    tap = min(max(first + a, lo), hi)
+                    acc += weight(fkind, fp0, fp1, fp2, pos - (first + a)) * src[s, r, tap]
                 out[s, r, q] = acc
                 done += 1
         counts[s] += done
