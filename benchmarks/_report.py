@@ -1,11 +1,22 @@
 """Output of the benchmark scripts: Markdown tables on stdout, JSON records under build/."""
 
 import json
+import time
 from pathlib import Path
 
 from vrlib._io import atomic_path
 
 ROOT = Path(__file__).resolve().parent.parent
+
+
+def best_of(fn, repeats=3):
+    """``(seconds, result)`` of the fastest of ``repeats`` calls of ``fn``."""
+    runs = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        result = fn()
+        runs.append((time.perf_counter() - start, result))
+    return min(runs, key=lambda run: run[0])
 
 
 def markdown(header, rows):

@@ -25,7 +25,7 @@ import tracemalloc
 os.environ.setdefault("VTK_DEFAULT_OPENGL_WINDOW", "vtkEGLRenderWindow")
 
 import numpy as np  # noqa: E402
-from _report import markdown, write_record  # noqa: E402
+from _report import best_of, markdown, write_record  # noqa: E402
 
 import data_gen  # noqa: E402
 import vrlib  # noqa: E402
@@ -45,13 +45,6 @@ def scenes():
     }
 
 
-def best_of(fn, repeats=3):
-    times = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        result = fn()
-        times.append(time.perf_counter() - start)
-    return min(times), result
 
 
 class VTKCaster:

@@ -14,11 +14,10 @@ The side-by-side with VolPack itself (Debian's libvolpack1) is not built yet.
 
 from __future__ import annotations
 
-import time
 import tracemalloc
 
 import numpy as np
-from _report import markdown, write_record
+from _report import best_of, markdown, write_record
 
 import data_gen
 import vrlib
@@ -34,13 +33,6 @@ def scenes():
             "sparse": (blobs, sparse_tf)}
 
 
-def best(fn, repeats=3):
-    runs = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        img = fn()
-        runs.append((time.perf_counter() - start, img))
-    return min(runs, key=lambda r: r[0])
 
 
 def main():
@@ -62,8 +54,8 @@ def main():
                 return vrlib.render(volume, view, transfer=transfer, threads=threads, **options)
 
             go(2)
-            t1, _ = best(lambda go=go: go(1))
-            t2, img = best(lambda go=go: go(2))
+            t1, _ = best_of(lambda go=go: go(1))
+            t2, img = best_of(lambda go=go: go(2))
             tracemalloc.start()
             go(2)
             peak = tracemalloc.get_traced_memory()[1]

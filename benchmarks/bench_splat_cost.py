@@ -15,11 +15,10 @@ from __future__ import annotations
 
 import os
 import platform
-import time
 import tracemalloc
 
 import numpy as np
-from _report import markdown, write_record
+from _report import best_of, markdown, write_record
 
 import data_gen
 from vrlib import Glow, View, Volume, render
@@ -36,13 +35,6 @@ def volumes():
     return {"dense": dense, "sparse": Volume(data, copy=False)}
 
 
-def best(fn, repeats=3):
-    runs = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        img = fn()
-        runs.append((time.perf_counter() - start, img))
-    return min(runs, key=lambda r: r[0])
 
 
 def footprint_errors():
@@ -92,9 +84,9 @@ def main():
                     cast()
                     splat("sheet")
                     splat("direct")  # compile and build the footprint tables first
-                    t_cast, img_cast = best(cast)
-                    t_sheet, img_sheet = best(lambda: splat("sheet"))
-                    t_direct, _ = best(lambda: splat("direct"))
+                    t_cast, img_cast = best_of(cast)
+                    t_sheet, img_sheet = best_of(lambda: splat("sheet"))
+                    t_direct, _ = best_of(lambda: splat("direct"))
                     tracemalloc.start()
                     splat("sheet")
                     peak = tracemalloc.get_traced_memory()[1]

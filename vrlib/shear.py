@@ -126,15 +126,20 @@ def plan_shear(volume, view, ds):
                      np.array([t0, ty, tz - z_first]))
 
 
-def _check(view, filt):
+def _check(view, filt, refusal):
+    """Refuse perspective views (with ``refusal``) and filters wider than 4 voxels; return the
+    filter's taps per axis."""
     if view.is_perspective:
-        raise ValueError("three- and two-pass shearing factor an affine view: orthographic "
-                         "only; use method='shearwarp' or 'raycast' for perspective")
+        raise ValueError(refusal)
     ntaps = taps_per_axis(filt)
     if ntaps > 8:
         raise ValueError(f"filter radius {filt.radius:g} is out of range: shearing takes radii "
                          "up to 4 voxels")
     return ntaps
+
+
+_AFFINE_ONLY = ("three- and two-pass shearing factor an affine view: orthographic only; use "
+                "method='shearwarp' or 'raycast' for perspective")
 
 
 def _filled(first, last, length):
@@ -193,7 +198,7 @@ def _stats(volume, taps, count, composited, seconds, largest):
 def render_shear3(volume, view, *, filt, transfer, step, early_termination,
                   empty_space_skipping):
     """Three-pass shear rendering (arguments validated by :func:`vrlib.render`)."""
-    ntaps = _check(view, filt)
+    ntaps = _check(view, filt, _AFFINE_ONLY)
     start = time.perf_counter()
     ds = step * float(volume.spacing.min())
     plan = plan_shear(volume, view, ds)
@@ -223,7 +228,7 @@ def render_shear2(volume, view, *, filt, transfer, step, early_termination,
                   empty_space_skipping):
     """Two-pass shear rendering (arguments validated by :func:`vrlib.render`). ``step`` sets
     the lattice of the image plane only: samples along a ray are the volume's slices."""
-    ntaps = _check(view, filt)
+    ntaps = _check(view, filt, _AFFINE_ONLY)
     start = time.perf_counter()
     ds = step * float(volume.spacing.min())
     plan = plan_shear(volume, view, ds)
@@ -290,13 +295,8 @@ def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
     from vrlib.splat import _slice_order, major_axis
 
     min_opacity = finite_number("min_opacity", min_opacity, low=0.0, high=1.0, high_open=True)
-    if view.is_perspective:
-        raise ValueError("shear-warp is implemented for orthographic views only so far; "
-                         "use method='raycast' for perspective")
-    ntaps = taps_per_axis(filt)
-    if ntaps > 8:
-        raise ValueError(f"filter radius {filt.radius:g} is out of range: shearing takes radii "
-                         "up to 4 voxels")
+    ntaps = _check(view, filt, "shear-warp is implemented for orthographic views only so far; "
+                               "use method='raycast' for perspective")
     start = time.perf_counter()
     axis, ascending = major_axis(volume, view)
     p_axis, q_axis = [a for a in range(3) if a != axis]

@@ -18,15 +18,7 @@ from numba import prange
 from vrlib._kernels._jit import jit, parallel_jit
 from vrlib._kernels.filters import weight
 from vrlib._kernels.raycast import _lookup
-
-
-@jit
-def _clamp(i, n):
-    if i < 0:
-        return 0
-    if i > n - 1:
-        return n - 1
-    return i
+from vrlib._kernels.sampling import _clamp
 
 
 @parallel_jit
