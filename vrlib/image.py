@@ -30,11 +30,14 @@ class RenderStats:
         Wall time of the render.
     voxels : int
         Voxels drawn (splatting) or resampled (shearing); 0 for ray casting.
+    passes : dict or None
+        Shearing: samples resampled by each pass (``pass1``, ``pass2``, ``pass3``) and the
+        bytes of the intermediate volumes (``buffers``).
 
     Examples
     --------
     >>> RenderStats(samples=10, seconds=0.5).as_dict()
-    {'samples': 10, 'operations': 0, 'bytes': 0, 'seconds': 0.5, 'voxels': 0}
+    {'samples': 10, 'operations': 0, 'bytes': 0, 'seconds': 0.5, 'voxels': 0, 'passes': None}
     """
 
     samples: int = 0
@@ -42,6 +45,7 @@ class RenderStats:
     bytes: int = 0
     seconds: float = 0.0
     voxels: int = 0
+    passes: dict | None = None
 
     def as_dict(self):
         """The counters as a plain dict."""

@@ -192,7 +192,7 @@ def _stats(volume, taps, count, composited, seconds, largest):
     resampled = count["pass1"] + count["pass2"] + count.get("pass3", 0)
     return RenderStats(samples=resampled + composited,
                        operations=resampled * 12 * taps + composited * 12,
-                       bytes=int(largest), seconds=seconds, voxels=resampled)
+                       bytes=int(largest), seconds=seconds, voxels=resampled, passes=count)
 
 
 def render_shear3(volume, view, *, filt, transfer, step, early_termination,
@@ -220,7 +220,6 @@ def render_shear3(volume, view, *, filt, transfer, step, early_termination,
                               tables[1], tables[2], tables[3], early_termination, out, counts)
     stats = _stats(volume, ntaps, count, int(counts.sum()), time.perf_counter() - start,
                    largest)
-    stats.passes = count
     return Image(np.clip(out, 0.0, 1.0), stats)
 
 
@@ -246,7 +245,6 @@ def render_shear2(volume, view, *, filt, transfer, step, early_termination,
                              tables[2], tables[3], early_termination, out, counts)
     stats = _stats(volume, ntaps, count, int(counts.sum()), time.perf_counter() - start,
                    count["buffers"])
-    stats.passes = count
     return Image(np.clip(out, 0.0, 1.0), stats)
 
 
