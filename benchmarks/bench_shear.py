@@ -9,7 +9,11 @@ VolPack's thresholds act on each voxel's opacity per slice; under the glow funct
 resolution every voxel of the dense scene is fainter than 0.05 (one slice is 1/256 of the
 volume), so the lossy setting drops them all: the row shows what such a threshold can cost.
 
-The side-by-side with VolPack itself (Debian's libvolpack1) is not built yet.
+VolPack itself (Debian's ``libvolpack1``, through ctypes: ``_volpack.py``) renders the same
+volume, view and glow table beside them, with the thresholds off and at 0.05 / 0.95, when the
+library is installed (``make bench`` installs it when it can); otherwise its rows are skipped
+with a message. VolPack is single-threaded; its classification (run once per volume and
+transfer function) is timed apart from the render.
 """
 
 from __future__ import annotations
@@ -18,6 +22,7 @@ import tracemalloc
 
 import numpy as np
 from _report import best_of, markdown, write_record
+from _volpack import VolPack, load
 
 import data_gen
 import vrlib
@@ -66,6 +71,21 @@ def main():
             rows.append([scene, label, f"{t2:.3f}", f"{t1 / t2:.2f}", f"{error:.2e}",
                          f"{peak / 2**20:.0f}"])
             print("| " + " | ".join(rows[-1]) + " |", flush=True)
+        lib = load()
+        if lib is None:
+            print("VolPack (libvolpack1) is not installed: its comparison is skipped")
+            continue
+        for label, low, high in [("VolPack 0/1", 0.0, 1.0), ("VolPack 0.05/0.95", 0.05, 0.95)]:
+            vp = VolPack(lib, volume, view, transfer, min_opacity=low, max_opacity=high)
+            vp.render()
+            t, _ = best_of(vp.render)
+            error = vrlib.metrics.rmse(vp.alpha(), ref)
+            record["rows"].append({"scene": scene, "config": label, "t1": t, "t2": None,
+                                   "rmse": error, "classify_s": vp.classify_seconds})
+            rows.append([scene, label, f"{t:.3f} (1 thread)", "-", f"{error:.2e}",
+                         f"classify {vp.classify_seconds:.2f} s"])
+            print("| " + " | ".join(rows[-1]) + " |", flush=True)
+            vp.close()
     print(f"\n{N}^3 -> {SIZE}^2, orthographic, trilinear (tent) filters\n")
     print(markdown(["scene", "method", "2 threads (s)", "1t / 2t", "rmse", "peak MiB"], rows))
     write_record("shear", record)
