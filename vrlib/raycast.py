@@ -17,6 +17,7 @@ import numba
 import numpy as np
 
 from vrlib._kernels import raycast as _kernel
+from vrlib._kernels.filters import TENT
 from vrlib._kernels.sampling import MAX_TAPS
 from vrlib._scheduling import balanced_order
 from vrlib.image import Image, RenderStats
@@ -50,17 +51,11 @@ def operations_per_sample(filt, *, shading=False):
     56
     """
     n = taps_per_axis(filt)
-    recon = 30 if filt.code[0] == _kernel_tent() else 30 * n + 2 * (n**3 + n**2)
+    recon = 30 if filt.code[0] == TENT else 30 * n + 2 * (n**3 + n**2)
     ops = 6 + recon + 20
     if shading:
         ops += 30 * n + 6 * n**3 + 30
     return ops
-
-
-def _kernel_tent():
-    from vrlib._kernels.filters import TENT
-
-    return TENT
 
 
 def reconstructed_range(volume, filt):

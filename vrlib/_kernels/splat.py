@@ -27,7 +27,7 @@ import numpy as np
 from numba import prange
 
 from vrlib._kernels._jit import jit, parallel_jit
-from vrlib._kernels.raycast import pixel_ray
+from vrlib._kernels.raycast import _lookup, pixel_ray
 
 SHEET, DIRECT = 0, 1
 RADIAL, PLANAR = 0, 1
@@ -35,27 +35,15 @@ RADIAL, PLANAR = 0, 1
 
 @jit
 def _table_value(start, inv, tab, value):
-    x = (value - start) * inv
-    n = tab.shape[0]
-    if not x > 0.0:
-        return tab[0]
-    if x >= n - 1:
-        return tab[n - 1]
-    i = int(x)
-    w = x - i
+    """Density table at ``value``, linearly interpolated and clamped (the shared lookup)."""
+    i, w = _lookup((value - start) * inv, tab.shape[0])
     return tab[i] + w * (tab[i + 1] - tab[i])
 
 
 @jit
 def _emission(start, inv, tab, value, channel):
-    x = (value - start) * inv
-    n = tab.shape[0]
-    if not x > 0.0:
-        return tab[0, channel]
-    if x >= n - 1:
-        return tab[n - 1, channel]
-    i = int(x)
-    w = x - i
+    """Emission table's ``channel`` at ``value``, as :func:`_table_value`."""
+    i, w = _lookup((value - start) * inv, tab.shape[0])
     return tab[i, channel] + w * (tab[i + 1, channel] - tab[i, channel])
 
 
