@@ -237,35 +237,49 @@ def shear_naive(volume, view, filt, transfer, step, passes):
 
 
 def shearwarp_naive(volume, view, filt, transfer):
-    """Shear-warp by the book: each slice resampled onto the intermediate image with the
-    filter at its fractional offset, composited front to back, then the intermediate image
-    sampled bilinearly where each pixel's ray meets slice 0."""
+    """Shear-warp by the book: the intermediate image lies on the front slice's plane at its
+    resolution; each of its pixels follows its ray (parallel, or from the eye) through every
+    slice, resamples the slice where the ray meets it with the 2-D filter and composites front
+    to back, each segment as long as the ray's path between slices (half on the end slices);
+    then the intermediate image is sampled bilinearly where each pixel's ray meets the plane."""
     from vrlib.splat import major_axis
 
     axis, ascending = major_axis(volume, view)
     p_axis, q_axis = [a for a in range(3) if a != axis]
+    axes = [q_axis, p_axis, axis]
     slices = np.transpose(np.asarray(volume.data, float),
                           (2 - axis, 2 - p_axis, 2 - q_axis))
     n_k, n_j, n_i = slices.shape
-    h = volume.spacing
-    direction = view.forward / h
-    si, sj = direction[q_axis] / direction[axis], direction[p_axis] / direction[axis]
-    oi, oj = max(0.0, si * (n_k - 1)), max(0.0, sj * (n_k - 1))
-    width = math.ceil(n_i + abs(si) * (n_k - 1))
-    height = math.ceil(n_j + abs(sj) * (n_k - 1))
-    length = h[axis] / abs(view.forward[axis])
+    h = volume.spacing[axes]
+    kf = 0 if ascending else n_k - 1
+    eye = None if view.eye is None else (view.eye - volume.origin)[axes] / h
+
+    def hit(point, k):  # where the ray through plane point (i, j) meets slice k
+        d = (view.forward[axes] / h) if eye is None else np.r_[point, kf] - eye
+        return point + d[:2] * (k - kf) / d[2], np.linalg.norm(d * h) / abs(d[2])
+
+    # Plane extent: the end slices' corners projected back onto the plane.
+    ext = []
+    for k in (0, n_k - 1):
+        for c in [(0, 0), (n_i - 1, n_j - 1)]:
+            c = np.array(c, float)
+            if eye is None:
+                d = view.forward[axes] / h
+                ext.append(c - d[:2] * (k - kf) / d[2])
+            else:
+                ext.append(eye[:2] + (c - eye[:2]) * (kf - eye[2]) / (k - eye[2]))
+    low, high = np.min(ext, axis=0), np.max(ext, axis=0)
+    width, height = (np.ceil(high - low - 1e-9).astype(int) + 1)
     inter = np.zeros((height, width, 4))
     taps = max(1, math.ceil(2 * filt.radius))
-    for k in (range(n_k) if ascending else range(n_k - 1, -1, -1)):
-        for big_j in range(height):
-            j = big_j - oj + sj * k
-            if not 0 <= j <= n_j - 1:
-                continue
-            jdx = math.floor(j - filt.radius) + 1 + np.arange(taps)
-            for big_i in range(width):
-                i = big_i - oi + si * k
-                if not 0 <= i <= n_i - 1:
+    for big_j in range(height):
+        for big_i in range(width):
+            point = np.array([big_i, big_j], float) + low
+            for k in (range(n_k) if ascending else range(n_k - 1, -1, -1)):
+                (i, j), length = hit(point, k)
+                if not (0 <= i <= n_i - 1 and 0 <= j <= n_j - 1):
                     continue
+                jdx = math.floor(j - filt.radius) + 1 + np.arange(taps)
                 idx = math.floor(i - filt.radius) + 1 + np.arange(taps)
                 patch = slices[k][np.ix_(np.clip(jdx, 0, n_j - 1), np.clip(idx, 0, n_i - 1))]
                 value = filt(j - jdx) @ patch @ filt(i - idx)
@@ -276,10 +290,11 @@ def shearwarp_naive(volume, view, filt, transfer):
                 inter[big_j, big_i] += (1 - inter[big_j, big_i, 3]) * np.r_[colour * alpha,
                                                                               alpha]
     origins, directions = view.rays()
-    t = (volume.origin[axis] - origins[..., axis]) / directions[..., axis]
+    plane = volume.origin[axis] + kf * volume.spacing[axis]
+    t = (plane - origins[..., axis]) / directions[..., axis]
     points = origins + t[..., None] * directions
-    x = (points[..., q_axis] - volume.origin[q_axis]) / h[q_axis] + oi
-    y = (points[..., p_axis] - volume.origin[p_axis]) / h[p_axis] + oj
+    x = (points[..., q_axis] - volume.origin[q_axis]) / h[0] - low[0]
+    y = (points[..., p_axis] - volume.origin[p_axis]) / h[1] - low[1]
     out = np.zeros(view.shape + (4,))
     inside = (x >= 0) & (y >= 0) & (x <= width - 1) & (y <= height - 1)
     i0 = np.clip(np.floor(x).astype(int), 0, width - 2)

@@ -8,6 +8,9 @@ weights ``w`` at a point, ``R = sum w f`` lies within
 with negative lobes (Catmull-Rom, Mitchell) this allows for overshoot; for the Gaussian, whose
 weights do not sum to one, for its ripple. The test is conservative, so skipping never changes
 an image.
+
+Slice-by-slice renderers (shear-warp) skip along rows instead: :func:`transparent_runs` gives,
+for each row of each slice, the first and last sample above a transparency bound.
 """
 
 from __future__ import annotations
@@ -19,7 +22,7 @@ import numpy as np
 
 from vrlib.filters import make_filter
 
-__all__ = ["empty_blocks", "lattice_sums", "filter_margin"]
+__all__ = ["empty_blocks", "lattice_sums", "filter_margin", "transparent_runs"]
 
 
 @functools.lru_cache(maxsize=64)
@@ -88,3 +91,42 @@ def empty_blocks(volume, filt, transfer, *, block=8):
     low = np.minimum(centre * s_min, centre * s_max) - reach
     high = np.maximum(centre * s_min, centre * s_max) + reach
     return np.asarray(transfer.max_density(low, high)) <= 0.0
+
+
+_RUNS_KEPT = 8  # run tables cached per volume (one per slicing axis and transfer function)
+
+
+def transparent_runs(volume, axis, bound):
+    """First and last sample above ``bound`` in each row of each slice along ``axis``.
+
+    Slices and rows as :meth:`vrlib.Volume.slices` lays them out; the arrays are
+    ``[slice, row]``, and ``first > last`` marks a row with nothing above ``bound``. Built
+    once per volume, axis and bound and cached on the volume (the preprocessing of Lacroute
+    and Levoy's run-length encoding); ``bound`` below every sample gives full rows without
+    reading them.
+
+    Examples
+    --------
+    >>> from vrlib import Volume
+    >>> data = np.zeros((3, 3, 4)); data[1, 2, 1:3] = 1.0     # [z, y, x]
+    >>> first, last = transparent_runs(Volume(data), 2, 0.5)
+    >>> first[1].tolist(), last[1].tolist()                   # slice z = 1, rows y
+    ([4, 4, 1], [-1, -1, 2])
+    """
+    slab = volume.slices(axis)
+    n_k, n_j, n_i = slab.shape
+    if bound < float(volume.value_range[0]):
+        return np.zeros((n_k, n_j), np.int64), np.full((n_k, n_j), n_i - 1, np.int64)
+    key = ("runs", axis, float(bound))
+    derived = volume._derived
+    if key not in derived:
+        marks = slab > bound
+        seen = marks.any(axis=2)
+        first = np.where(seen, marks.argmax(axis=2), n_i).astype(np.int64)
+        last = np.where(seen, n_i - 1 - marks[:, :, ::-1].argmax(axis=2), -1).astype(np.int64)
+        first.flags.writeable = last.flags.writeable = False
+        kept = [k for k in derived if k[0] == "runs"]
+        for old in kept[: max(0, len(kept) - _RUNS_KEPT + 1)]:
+            del derived[old]
+        derived[key] = (first, last)
+    return derived[key]

@@ -130,7 +130,7 @@ class Volume:
         arr.flags.writeable = False
         self._data = arr
         self._extent = _check_extent(DEFAULT_EXTENT if extent is None else extent)
-        self._pyramids = {}
+        self._derived = {}  # cached structures built from the samples (pyramids, runs)
         self._range = None
 
     # -- lattice geometry ------------------------------------------------------------------
@@ -232,10 +232,39 @@ class Volume:
         """
         block = _validate.positive_int("block", block)
         margin = _validate.positive_int("margin", margin, minimum=0)
-        key = (block, margin)
-        if key not in self._pyramids:
-            self._pyramids[key] = _build_pyramid(self._data, block, margin)
-        return self._pyramids[key]
+        key = ("pyramid", block, margin)
+        if key not in self._derived:
+            self._derived[key] = _build_pyramid(self._data, block, margin)
+        return self._derived[key]
+
+    def slices(self, axis):
+        """The samples as a stack of slices along ``axis`` (0, 1, 2 for x, y, z), indexed
+        ``[slice, row, column]``: rows run along the higher of the other two axes and columns
+        along the lower, so that every row is contiguous in memory.
+
+        Slices along z and y are views of the data; slices along x need a transposed copy,
+        made on first use and cached (the same memory as the data), as shear-warp renderers
+        keep one copy of the volume per principal axis.
+
+        Examples
+        --------
+        >>> vol = Volume(np.arange(24.0).reshape(2, 3, 4))      # [z, y, x]
+        >>> vol.slices(0).shape, vol.slices(0)[1, :, 0].tolist()  # slice x = 1: rows z, columns y
+        ((4, 2, 3), [1.0, 13.0])
+        >>> vol.slices(2).base is not None                       # along z: a view
+        True
+        """
+        axis = _validate.choice("axis", axis, (0, 1, 2))
+        if axis == 2:
+            return self._data
+        if axis == 1:
+            return self._data.transpose(1, 0, 2)
+        key = ("slices", 0)
+        if key not in self._derived:
+            copy = np.ascontiguousarray(self._data.transpose(2, 0, 1))
+            copy.flags.writeable = False
+            self._derived[key] = copy
+        return self._derived[key]
 
     def __repr__(self):
         ext = ", ".join(f"[{lo:g}, {hi:g}]" for lo, hi in self._extent)

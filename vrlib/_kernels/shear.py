@@ -64,39 +64,39 @@ def shear_pass(src, out, c0, c1, c2, offset, line_lo, line_hi, fkind, fp0, fp1, 
 
 
 @jit
-def _classify_over(value, tstart, tinv, alpha_tab, color_tab, acc, half):
-    """Classify one sample from the segment table and composite it under ``acc`` (eqs 1.7-1.8,
-    colour E alpha: eq 1.9). With ``half`` the segment is half the table's length: the first
-    and last slices of a volume reach only half a slice spacing into it, and
-    ``1 - alpha_half = sqrt(1 - alpha)``."""
+def _over(value, fraction, tstart, tinv, alpha_tab, color_tab, buf, y, x):
+    """Classify one sample from the segment table and composite it under ``buf[y, x]``
+    (premultiplied RGBA; eqs 1.7-1.8, colour E alpha: eq 1.9). ``fraction`` is the sample's
+    segment length over the table's: ``1 - alpha' = (1 - alpha) ** fraction``, the colour
+    scaled with the opacity (the first and last slices of a volume reach half a slice spacing
+    into it; perspective rays cross the slices at their own angles)."""
     i, w = _lookup((value - tstart) * tinv, alpha_tab.shape[0])
     alpha = alpha_tab[i] + w * (alpha_tab[i + 1] - alpha_tab[i])
-    if alpha > 0.0:
-        scale = 1.0
-        if half:
-            shorter = 1.0 - math.sqrt(1.0 - alpha)
-            scale = shorter / alpha
-            alpha = shorter
-        remaining = 1.0 - acc[3]
-        for ch in range(3):
-            acc[ch] += remaining * scale * (color_tab[i, ch] + w * (color_tab[i + 1, ch]
+    if not alpha > 0.0:
+        return
+    scale = 1.0
+    if fraction != 1.0:
+        corrected = -math.expm1(fraction * math.log1p(-alpha))
+        scale = corrected / alpha
+        alpha = corrected
+    remaining = 1.0 - buf[y, x, 3]
+    for ch in range(3):
+        buf[y, x, ch] += remaining * scale * (color_tab[i, ch] + w * (color_tab[i + 1, ch]
                                                                       - color_tab[i, ch]))
-        acc[3] += remaining * alpha
+    buf[y, x, 3] += remaining * alpha
 
 
 @parallel_jit
 def composite_lattice(vol, inverse, shift, limits, tstart, tinv, alpha_tab, color_tab,
                       threshold, out, counts):
     """Three-pass compositing: ``vol[Z, Y, X]`` lies on the image lattice; each pixel takes its
-    samples in order of increasing ``Z`` (front to back). A sample belongs to the volume when
+    samples in order of increasing ``Z`` (front to back) into ``out`` (zeros). A sample belongs to the volume when
     ``inverse @ ((X, Y, Z) - shift)`` lies within ``[0, limits]`` on every axis."""
     n_z, height, width = vol.shape
     for row_index in prange(height):
         y = np.int64(row_index)
-        acc = np.zeros(4)
         done = 0
         for x in range(width):
-            acc[:] = 0.0
             for z in range(n_z):
                 inside = True
                 for a in range(3):
@@ -107,11 +107,9 @@ def composite_lattice(vol, inverse, shift, limits, tstart, tinv, alpha_tab, colo
                 if not inside:
                     continue
                 done += 1
-                _classify_over(vol[z, y, x], tstart, tinv, alpha_tab, color_tab, acc, False)
-                if acc[3] >= threshold:
+                _over(vol[z, y, x], 1.0, tstart, tinv, alpha_tab, color_tab, out, y, x)
+                if out[y, x, 3] >= threshold:
                     break
-            for ch in range(4):
-                out[y, x, ch] = acc[ch]
         counts[y] = done
 
 
@@ -126,10 +124,8 @@ def composite_slices(vol, front_to_back, inverse2, shift, limits, tstart, tinv, 
     n_w, height, width = vol.shape
     for row_index in prange(height):
         y = np.int64(row_index)
-        acc = np.zeros(4)
         done = 0
         for x in range(width):
-            acc[:] = 0.0
             for step in range(n_w):
                 w = step if front_to_back else n_w - 1 - step
                 dx = x - shift[0] - w * shift[2]
@@ -139,89 +135,111 @@ def composite_slices(vol, front_to_back, inverse2, shift, limits, tstart, tinv, 
                 if u < 0.0 or u > limits[0] or v < 0.0 or v > limits[1]:
                     continue
                 done += 1
-                _classify_over(vol[w, y, x], tstart, tinv, alpha_tab, color_tab, acc,
-                               w == 0 or w == n_w - 1)
-                if acc[3] >= threshold:
+                end = 0.5 if w == 0 or w == n_w - 1 else 1.0
+                _over(vol[w, y, x], end, tstart, tinv, alpha_tab, color_tab, out, y, x)
+                if out[y, x, 3] >= threshold:
                     break
-            for ch in range(4):
-                out[y, x, ch] = acc[ch]
         counts[y] = done
 
 
 @parallel_jit
-def shear_slices(slices, order, di, dj, fkind, fp0, fp1, fp2, radius, ntaps, tstart, tinv,
-                 alpha_tab, color_tab, threshold, first, last, inter, counts):
+def shear_slices(slices, order, scale, di, dj, fraction, fkind, fp0, fp1, fp2, radius, ntaps,
+                 tstart, tinv, alpha_tab, color_tab, threshold, first, last, inter, counts):
     """Shear-warp's compositing into the intermediate image (Lacroute and Levoy 1994).
 
-    ``slices[k, j, i]`` is the volume in slice order; slice ``k`` lands on the intermediate
-    image translated so that intermediate pixel ``(I, J)`` samples the slice at
-    ``(i, j) = (I + di[k], J + dj[k])``: one fractional offset per slice, so the filter's
-    weights are the same for every pixel of it. Slices are taken in ``order`` (front to back)
-    and composited into ``inter[J, I]`` (premultiplied RGBA), each a segment of the table's
-    length but the first and last, half as long. Row ``j`` of slice ``k`` holds
-    nothing visible outside columns ``first[k, j] .. last[k, j]``; pixels whose opacity has
-    reached ``threshold`` take no more. Each task owns intermediate rows: no races.
+    ``slices[k, j, i]`` is the volume in slice order. Intermediate pixel ``(I, J)`` samples
+    slice ``k`` at ``(i, j) = scale[k] (I, J) + (di[k], dj[k])``: a translation (orthographic,
+    ``scale = 1``: one fractional offset per slice, so one set of filter weights serves the
+    whole slice) or a translation and scale (perspective). Slices are taken in ``order`` (front
+    to back) and composited into ``inter[J, I]`` (premultiplied RGBA, zeros on entry), each a
+    segment of the table's length times ``fraction[J, I]`` (shape ``(1, 1)``: 1 everywhere),
+    halved on the first and last slice. Row ``j`` of slice ``k`` holds nothing visible outside
+    columns ``first[k, j] .. last[k, j]``; pixels whose opacity has reached ``threshold`` take
+    no more. Each task owns intermediate rows: no races.
     """
     n_k, n_j, n_i = slices.shape
     height, width = inter.shape[0], inter.shape[1]
+    uniform = fraction.shape[0] == 1
     for row in prange(height):
         big_j = np.int64(row)
         wi = np.empty(8)
         wj = np.empty(8)
+        rows = np.empty(8, np.int64)
         done = 0
         for step in range(n_k):
             k = order[step]
-            j = big_j + dj[k]
+            s = scale[k]
+            j = s * big_j + dj[k]
             if j < 0.0 or j > n_j - 1:
                 continue
             j_first = int(math.floor(j - radius)) + 1
-            for b in range(ntaps):
-                wj[b] = weight(fkind, fp0, fp1, fp2, j - (j_first + b))
             # Columns this row can draw: the union of the tap rows' visible runs, widened.
             lo = n_i
             hi = -1
             for b in range(ntaps):
-                jj = _clamp(j_first + b, n_j)
-                if first[k, jj] <= last[k, jj]:
-                    lo = min(lo, first[k, jj])
-                    hi = max(hi, last[k, jj])
+                wj[b] = weight(fkind, fp0, fp1, fp2, j - (j_first + b))
+                rows[b] = _clamp(j_first + b, n_j)
+                if first[k, rows[b]] <= last[k, rows[b]]:
+                    lo = min(lo, first[k, rows[b]])
+                    hi = max(hi, last[k, rows[b]])
             if lo > hi:
                 continue
-            frac_first = int(math.floor(di[k] - radius)) + 1  # tap offset of I = 0
-            for a in range(ntaps):
-                wi[a] = weight(fkind, fp0, fp1, fp2, di[k] - (frac_first + a))
-            i_lo = -di[k]  # intermediate columns whose sample lies in the slice
-            i_hi = n_i - 1.0 - di[k]
-            big_first = max(int(math.ceil(i_lo)), int(math.floor(lo - radius - di[k])))
-            big_last = min(int(math.floor(i_hi)), int(math.ceil(hi + radius - di[k])), width - 1)
-            for big_i in range(max(big_first, 0), big_last + 1):
+            i_lo = max(0.0, lo - radius)
+            i_hi = min(n_i - 1.0, hi + radius)
+            big_first = max(0, int(math.ceil((i_lo - di[k]) / s)))
+            big_last = min(width - 1, int(math.floor((i_hi - di[k]) / s)))
+            shared = s == 1.0
+            tap0 = int(math.floor(di[k] - radius)) + 1  # orthographic: first tap - I
+            if shared:
+                for a in range(ntaps):
+                    wi[a] = weight(fkind, fp0, fp1, fp2, di[k] - (tap0 + a))
+            end = 0.5 if k == 0 or k == n_k - 1 else 1.0
+            for big_i in range(big_first, big_last + 1):
                 if inter[big_j, big_i, 3] >= threshold:
                     continue
-                value = 0.0
-                for b in range(ntaps):
-                    jj = _clamp(j_first + b, n_j)
-                    line = 0.0
+                if shared:
+                    i0 = big_i + tap0
+                else:
+                    i = s * big_i + di[k]
+                    i0 = int(math.floor(i - radius)) + 1
                     for a in range(ntaps):
-                        line += wi[a] * slices[k, jj, _clamp(big_i + frac_first + a, n_i)]
-                    value += wj[b] * line
+                        wi[a] = weight(fkind, fp0, fp1, fp2, i - (i0 + a))
+                value = 0.0
+                if i0 >= 0 and i0 + ntaps <= n_i:
+                    for b in range(ntaps):
+                        line = 0.0
+                        for a in range(ntaps):
+                            line += wi[a] * slices[k, rows[b], i0 + a]
+                        value += wj[b] * line
+                else:
+                    for b in range(ntaps):
+                        line = 0.0
+                        for a in range(ntaps):
+                            line += wi[a] * slices[k, rows[b], _clamp(i0 + a, n_i)]
+                        value += wj[b] * line
                 done += 1
-                _classify_over(value, tstart, tinv, alpha_tab, color_tab, inter[big_j, big_i],
-                               k == 0 or k == n_k - 1)
+                part = end if uniform else end * fraction[big_j, big_i]
+                _over(value, part, tstart, tinv, alpha_tab, color_tab, inter, big_j, big_i)
         counts[big_j] = done
 
 
 @parallel_jit
-def warp(inter, coords, out):
-    """The 2-D warp: ``out[r, c]`` is ``inter`` sampled bilinearly at ``coords[r, c] = (I, J)``
-    (transparent outside)."""
+def warp(inter, homography, out):
+    """The 2-D warp: ``out[r, c]`` is ``inter`` sampled bilinearly at ``(I, J) = (A, B) / D``
+    with ``(A, B, D) = homography @ (c, r, 1)`` (transparent outside, or where ``D <= 0``: the
+    pixel's ray never meets the intermediate image's plane)."""
     height, width = out.shape[0], out.shape[1]
     n_j, n_i = inter.shape[0], inter.shape[1]
+    m = homography
     for row in prange(height):
         for c in range(width):
-            x = coords[row, c, 0]
-            y = coords[row, c, 1]
             for ch in range(4):
                 out[row, c, ch] = 0.0
+            d = m[2, 0] * c + m[2, 1] * row + m[2, 2]
+            if not d > 0.0:
+                continue
+            x = (m[0, 0] * c + m[0, 1] * row + m[0, 2]) / d
+            y = (m[1, 0] * c + m[1, 1] * row + m[1, 2]) / d
             if not (x >= 0.0 and y >= 0.0 and x <= n_i - 1 and y <= n_j - 1):
                 continue
             i = min(int(x), n_i - 2)
