@@ -90,8 +90,9 @@ def _over(value, fraction, tstart, tinv, alpha_tab, color_tab, buf, y, x):
 def composite_lattice(vol, inverse, shift, limits, tstart, tinv, alpha_tab, color_tab,
                       threshold, out, counts):
     """Three-pass compositing: ``vol[Z, Y, X]`` lies on the image lattice; each pixel takes its
-    samples in order of increasing ``Z`` (front to back) into ``out`` (zeros). A sample belongs to the volume when
-    ``inverse @ ((X, Y, Z) - shift)`` lies within ``[0, limits]`` on every axis."""
+    samples in order of increasing ``Z`` (front to back) into ``out`` (zeros). A sample belongs
+    to the volume when ``inverse @ ((X, Y, Z) - shift)`` lies within ``[0, limits]`` on every
+    axis."""
     n_z, height, width = vol.shape
     for row_index in prange(height):
         y = np.int64(row_index)
