@@ -72,3 +72,14 @@ def write_csv(path, header, rows):
     writer.writerows(rows)
     with atomic_path(path) as tmp:
         tmp.write_text(buffer.getvalue())
+
+
+def progress(iterable, label, total=None):
+    """A progress bar on stderr for a long sweep (tqdm; quiet when stderr is not a terminal
+    except for a line at the start and the end)."""
+    import sys
+
+    from tqdm import tqdm
+
+    return tqdm(iterable, desc=label, total=total, file=sys.stderr, mininterval=2.0,
+                dynamic_ncols=True, disable=None if sys.stderr.isatty() else False)
