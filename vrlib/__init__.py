@@ -17,7 +17,7 @@ Conventions, stated once for the whole package:
 The public API is the list in ``__all__``.
 """
 
-from vrlib import compositing, filters, metrics
+from vrlib import bounds, compositing, filters, metrics
 from vrlib.filters import FILTERS, make_filter
 from vrlib.image import Image, RenderStats
 from vrlib.reference import render_reference
@@ -45,4 +45,5 @@ __all__ = [
     "filters",
     "compositing",
     "metrics",
+    "bounds",
 ]
