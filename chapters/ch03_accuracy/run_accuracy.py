@@ -1,0 +1,122 @@
+"""Image-based accuracy: every (method, filter) pair against the reference renderer on
+analytic volumes, at several sampling densities and views, under every image metric.
+
+Writes ``build/results/ch03_accuracy/accuracy.json`` (one record per render: case, method,
+filter, each metric's value) and ``images.npz`` (the Marschner-Lobb renders and a blob's, with
+their references, for the image grids).
+"""
+
+import numpy as np
+
+import data_gen
+import vrlib
+from chapters.common import atomic_path, by_profile, progress, result_path, write_json
+
+METHODS = ["raycast", "splat", "shear3", "shear2", "shearwarp"]
+FILTERS = ["box", "pyramid", "gaussian", "catmull-rom", "mitchell", "bspline"]
+# Each field with the glow scale that keeps its brightest pixel's optical depth near 1-2, so
+# that images are neither faint nor saturated.
+FIELDS = {
+    "blob s=0.08": (("gaussian-blob", {"sigma": 0.08}), 8.0),
+    "blob s=0.2": (("gaussian-blob", {"sigma": 0.2}), 3.0),
+    "grating f=2": (("grating", {"frequency": 2.0, "direction": (1.0, 0.6, 0.3)}), 1.0),
+    "grating f=5": (("grating", {"frequency": 5.0, "direction": (1.0, 0.6, 0.3)}), 1.0),
+    "marschner-lobb": (("marschner-lobb", {}), 1.0),
+    "smooth-sphere": (("smooth-sphere", {}), 1.5),
+}
+SIZES = by_profile([24, 41], [24, 41, 64])
+VIEWS = by_profile([(30, 25), (-70, 50)], [(30, 25), (-70, 50), (10, -15), (120, 80)])
+IMAGE = by_profile(96, 192)
+# Fields that vanish at the volume's faces: splatting's kernels reach past the faces, where the
+# ray caster and the reference stop, so the other fields add a boundary error to its images.
+VANISHING = ["blob s=0.08", "blob s=0.2", "smooth-sphere"]
+SAVED = {("marschner-lobb", 41, 0), ("blob s=0.08", 24, 0)}  # cases kept for the image grids
+
+
+def main():
+    records, images = [], {}
+    cases = [(f, n, v) for f in FIELDS for n in SIZES for v in range(len(VIEWS))]
+    references = {}
+    for field_name, n, v in progress(cases, "accuracy"):
+        (name, params), scale = FIELDS[field_name]
+        field = data_gen.make_field(name, **params)
+        transfer = vrlib.Glow(scale)
+        view = vrlib.View.orbit(azimuth=VIEWS[v][0], elevation=VIEWS[v][1], size=IMAGE)
+        if (field_name, v) not in references:
+            references[field_name, v] = vrlib.render_reference(field, view, transfer=transfer,
+                                                               tol=1e-6).alpha
+        ref = references[field_name, v]
+        volume = field.sample(n)
+        key = f"{field_name}|{n}|{v}"
+        if (field_name, n, v) in SAVED:
+            images[f"{key}|reference"] = ref
+        for method in METHODS:
+            for filt in FILTERS:
+                img = vrlib.render(volume, view, method=method, filter=filt, transfer=transfer,
+                                   step=0.5, early_termination=1.0).alpha
+                record = {"field": field_name, "n": n, "view": v, "method": method,
+                          "filter": filt}
+                for metric, fn in vrlib.metrics.METRICS.items():
+                    record[metric] = float(fn(img, ref))
+                records.append(record)
+                if (field_name, n, v) in SAVED:
+                    images[f"{key}|{method}|{filt}"] = img
+    write_json(result_path(__file__, "accuracy.json"), {
+        "records": records, "fields": list(FIELDS), "sizes": SIZES, "views": VIEWS,
+        "image": IMAGE, "methods": METHODS, "filters": FILTERS,
+        "metrics": list(vrlib.metrics.METRICS), "summary": summarise(records),
+        "vanishing_fields": VANISHING,
+        "summary_vanishing": summarise([r for r in records if r["field"] in VANISHING]),
+        "boundary_rmse": {m: {f: float(np.median([r["rmse"] for r in records
+                                                  if r["method"] == m and r["field"] == f]))
+                              for f in FIELDS} for m in METHODS}})
+    with atomic_path(result_path(__file__, "images.npz")) as tmp:
+        np.savez_compressed(tmp, **images)
+
+
+def summarise(records):
+    """Mean rank of each filter per method under each metric (rank 1: most accurate in a
+    case), the order that gives, and whether every metric gives the same order."""
+    metrics = list(vrlib.metrics.METRICS)
+    higher_is_better = {"psnr", "ssim"}
+    out = {}
+    for method in METHODS:  # the filters ranked within each method
+        rows = [r for r in records if r["method"] == method]
+        cases = sorted({(r["field"], r["n"], r["view"]) for r in rows})
+        ranks = {m: {f: [] for f in FILTERS} for m in metrics}
+        for case in cases:
+            in_case = [r for r in rows if (r["field"], r["n"], r["view"]) == case]
+            for m in metrics:
+                sign = -1.0 if m in higher_is_better else 1.0
+                ordered = sorted(in_case, key=lambda r, m=m, s=sign: s * r[m])
+                for rank, r in enumerate(ordered, start=1):
+                    ranks[m][r["filter"]].append(rank)
+        mean = {m: {f: float(np.mean(v)) for f, v in ranks[m].items()} for m in metrics}
+        order = {m: sorted(FILTERS, key=lambda f, m=m: mean[m][f]) for m in metrics}
+        out[method] = {"mean_rank": mean, "order": order,
+                       "same_order_every_metric": len({tuple(o) for o in order.values()}) == 1,
+                       "same_best_every_metric": len({o[0] for o in order.values()}) == 1,
+                       "cases": len(cases)}
+    # Every (method, filter) pair ranked together, case by case.
+    configs = [f"{m}/{f}" for m in METHODS for f in FILTERS]
+    cases = sorted({(r["field"], r["n"], r["view"]) for r in records})
+    overall = {m: {c: [] for c in configs} for m in metrics}
+    for case in cases:
+        in_case = [r for r in records if (r["field"], r["n"], r["view"]) == case]
+        for m in metrics:
+            sign = -1.0 if m in higher_is_better else 1.0
+            for rank, r in enumerate(sorted(in_case, key=lambda r, m=m, s=sign: s * r[m]), 1):
+                overall[m][f"{r['method']}/{r['filter']}"].append(rank)
+    mean = {m: {c: float(np.mean(v)) for c, v in overall[m].items()} for m in metrics}
+    out["overall"] = {
+        "mean_rank": mean,
+        "order": {m: sorted(configs, key=lambda c, m=m: mean[m][c]) for m in metrics},
+        "median_rmse": {c: float(np.median([r["rmse"] for r in records
+                                            if f"{r['method']}/{r['filter']}" == c]))
+                        for c in configs},
+    }
+    return out
+
+
+if __name__ == "__main__":
+    main()
