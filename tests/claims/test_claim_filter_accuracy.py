@@ -51,7 +51,6 @@ def test_a_truncated_gaussian_has_an_error_floor_the_cubic_does_not():
 
 
 def _image_errors(field, n, scale, methods, size=48):
-    import data_gen
     import vrlib
 
     view = vrlib.View.orbit(azimuth=30, elevation=25, size=size)
