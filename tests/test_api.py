@@ -12,7 +12,7 @@ import vrlib
 
 MODULES = [
     "vrlib.volume", "vrlib.filters", "vrlib.transfer", "vrlib.view", "vrlib.compositing",
-    "vrlib.image", "vrlib.metrics", "vrlib.bounds", "data_gen", "data_gen.fields",
+    "vrlib.image", "vrlib.metrics", "vrlib.bounds", "vrlib.cost", "data_gen", "data_gen.fields",
     "data_gen.loaders",
 ]
 # Abstract bases: their subclasses carry the examples.

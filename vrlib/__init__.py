@@ -17,7 +17,7 @@ Conventions, stated once for the whole package:
 The public API is the list in ``__all__``.
 """
 
-from vrlib import bounds, compositing, filters, metrics
+from vrlib import bounds, compositing, cost, filters, metrics
 from vrlib.filters import FILTERS, make_filter
 from vrlib.image import Image, RenderStats
 from vrlib.reference import render_reference
@@ -46,4 +46,5 @@ __all__ = [
     "compositing",
     "metrics",
     "bounds",
+    "cost",
 ]
