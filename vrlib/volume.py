@@ -251,7 +251,7 @@ class Volume:
         >>> vol = Volume(np.arange(24.0).reshape(2, 3, 4))      # [z, y, x]
         >>> vol.slices(0).shape, vol.slices(0)[1, :, 0].tolist()  # slice x = 1: rows z, columns y
         ((4, 2, 3), [1.0, 13.0])
-        >>> vol.slices(2).base is not None                       # along z: a view
+        >>> np.shares_memory(vol.slices(1), vol.data)            # along y: a view
         True
         """
         axis = _validate.choice("axis", axis, (0, 1, 2))
