@@ -74,43 +74,39 @@ def main():
         np.savez_compressed(tmp, **images)
 
 
+HIGHER_IS_BETTER = {"psnr", "ssim"}
+
+
+def mean_ranks(records, label):
+    """Mean rank (1: most accurate in a case) of each ``label(record)`` under every metric,
+    ranking the records case by case."""
+    ranks = {m: {} for m in vrlib.metrics.METRICS}
+    for case in sorted({(r["field"], r["n"], r["view"]) for r in records}):
+        in_case = [r for r in records if (r["field"], r["n"], r["view"]) == case]
+        for m in ranks:
+            sign = -1.0 if m in HIGHER_IS_BETTER else 1.0
+            for rank, r in enumerate(sorted(in_case, key=lambda r, m=m, s=sign: s * r[m]), 1):
+                ranks[m].setdefault(label(r), []).append(rank)
+    return {m: {k: float(np.mean(v)) for k, v in by.items()} for m, by in ranks.items()}
+
+
 def summarise(records):
-    """Mean rank of each filter per method under each metric (rank 1: most accurate in a
-    case), the order that gives, and whether every metric gives the same order."""
-    metrics = list(vrlib.metrics.METRICS)
-    higher_is_better = {"psnr", "ssim"}
+    """Mean rank of each filter per method under each metric, the order that gives, and
+    whether every metric gives the same order; then every (method, filter) pair together."""
     out = {}
     for method in METHODS:  # the filters ranked within each method
         rows = [r for r in records if r["method"] == method]
-        cases = sorted({(r["field"], r["n"], r["view"]) for r in rows})
-        ranks = {m: {f: [] for f in FILTERS} for m in metrics}
-        for case in cases:
-            in_case = [r for r in rows if (r["field"], r["n"], r["view"]) == case]
-            for m in metrics:
-                sign = -1.0 if m in higher_is_better else 1.0
-                ordered = sorted(in_case, key=lambda r, m=m, s=sign: s * r[m])
-                for rank, r in enumerate(ordered, start=1):
-                    ranks[m][r["filter"]].append(rank)
-        mean = {m: {f: float(np.mean(v)) for f, v in ranks[m].items()} for m in metrics}
-        order = {m: sorted(FILTERS, key=lambda f, m=m: mean[m][f]) for m in metrics}
+        mean = mean_ranks(rows, lambda r: r["filter"])
+        order = {m: sorted(FILTERS, key=lambda f, m=m: mean[m][f]) for m in mean}
         out[method] = {"mean_rank": mean, "order": order,
                        "same_order_every_metric": len({tuple(o) for o in order.values()}) == 1,
                        "same_best_every_metric": len({o[0] for o in order.values()}) == 1,
-                       "cases": len(cases)}
-    # Every (method, filter) pair ranked together, case by case.
+                       "cases": len({(r["field"], r["n"], r["view"]) for r in rows})}
     configs = [f"{m}/{f}" for m in METHODS for f in FILTERS]
-    cases = sorted({(r["field"], r["n"], r["view"]) for r in records})
-    overall = {m: {c: [] for c in configs} for m in metrics}
-    for case in cases:
-        in_case = [r for r in records if (r["field"], r["n"], r["view"]) == case]
-        for m in metrics:
-            sign = -1.0 if m in higher_is_better else 1.0
-            for rank, r in enumerate(sorted(in_case, key=lambda r, m=m, s=sign: s * r[m]), 1):
-                overall[m][f"{r['method']}/{r['filter']}"].append(rank)
-    mean = {m: {c: float(np.mean(v)) for c, v in overall[m].items()} for m in metrics}
+    mean = mean_ranks(records, lambda r: f"{r['method']}/{r['filter']}")
     out["overall"] = {
         "mean_rank": mean,
-        "order": {m: sorted(configs, key=lambda c, m=m: mean[m][c]) for m in metrics},
+        "order": {m: sorted(configs, key=lambda c, m=m: mean[m][c]) for m in mean},
         "median_rmse": {c: float(np.median([r["rmse"] for r in records
                                             if f"{r['method']}/{r['filter']}" == c]))
                         for c in configs},
