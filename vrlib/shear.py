@@ -126,10 +126,10 @@ def plan_shear(volume, view, ds):
                      np.array([t0, ty, tz - z_first]))
 
 
-def _check(view, filt, refusal):
-    """Refuse perspective views (with ``refusal``) and filters wider than 4 voxels; return the
-    filter's taps per axis."""
-    if view.is_perspective:
+def _check(view, filt, refusal=None):
+    """Refuse filters wider than 4 voxels, and perspective views with ``refusal`` when one is
+    given; return the filter's taps per axis."""
+    if refusal is not None and view.is_perspective:
         raise ValueError(refusal)
     ntaps = taps_per_axis(filt)
     if ntaps > 8:
@@ -364,10 +364,7 @@ def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
     from vrlib.splat import major_axis
 
     min_opacity = finite_number("min_opacity", min_opacity, low=0.0, high=1.0, high_open=True)
-    ntaps = taps_per_axis(filt)
-    if ntaps > 8:
-        raise ValueError(f"filter radius {filt.radius:g} is out of range: shearing takes radii "
-                         "up to 4 voxels")
+    ntaps = _check(view, filt)
     start = time.perf_counter()
     axis, ascending = major_axis(volume, view)
     scale, di, dj, (oi, oj), (height, width), kf, rays = _intermediate_plane(
