@@ -112,19 +112,45 @@ class Field:
         if np.dtype(dtype) not in (np.dtype(np.float32), np.dtype(np.float64)):
             raise ValueError(f"dtype must be float32 or float64, got {np.dtype(dtype)}")
         ext = _check_extent(self.bounds if extent is None else extent)
-        axes = [np.linspace(lo, hi, n) for (lo, hi), n in zip(ext, shape[::-1], strict=True)]
-        data = np.empty(shape, dtype=dtype)
-        plane = shape[1] * shape[2]
+        data = self.sample_region(shape, [(0, n) for n in shape], extent=ext, dtype=dtype)
+        return Volume(data, ext, copy=False)
+
+    def sample_region(self, shape, region, *, extent=None, dtype=np.float64):
+        """The samples ``region`` (``(start, stop)`` per axis, z, y, x) of the lattice that
+        :meth:`sample` would make with ``shape``, without the rest: how a rank of a parallel
+        renderer generates only its own brick. The values equal the same entries of
+        :meth:`sample`, bit for bit.
+
+        Examples
+        --------
+        >>> from data_gen import make_field
+        >>> field = make_field("marschner-lobb")
+        >>> part = field.sample_region((9, 9, 9), [(2, 5), (0, 9), (4, 6)])
+        >>> part.shape, bool((part == field.sample(9).data[2:5, :, 4:6]).all())
+        ((3, 9, 2), True)
+        """
+        shape = tuple(int(n) for n in shape)
+        ext = _check_extent(self.bounds if extent is None else extent)
+        region = [(int(a), int(b)) for a, b in region]
+        if len(region) != 3 or any(not 0 <= a < b <= n for (a, b), n in zip(region, shape,
+                                                                           strict=True)):
+            raise ValueError(f"region must be (start, stop) per axis within {shape}, with "
+                             f"start < stop; got {region}")
+        lattice = [np.linspace(lo, hi, n) for (lo, hi), n in zip(ext, shape[::-1], strict=True)]
+        axes = [lattice[a][slice(*region[2 - a])] for a in range(3)]  # x, y, z
+        size = tuple(b - a for a, b in region)
+        data = np.empty(size, dtype=dtype)
+        plane = size[1] * size[2]
         zs_per_chunk = max(1, _CHUNK // plane)
         y, x = np.meshgrid(axes[1], axes[0], indexing="ij")
-        for z0 in range(0, shape[0], zs_per_chunk):
+        for z0 in range(0, size[0], zs_per_chunk):
             zs = axes[2][z0 : z0 + zs_per_chunk]
-            pts = np.empty((len(zs), shape[1], shape[2], 3))
+            pts = np.empty((len(zs), size[1], size[2], 3))
             pts[..., 0] = x
             pts[..., 1] = y
             pts[..., 2] = zs[:, None, None]
             data[z0 : z0 + len(zs)] = self(pts)
-        return Volume(data, ext, copy=False)
+        return data
 
     def __repr__(self):
         params = ", ".join(f"{k}={v!r}" for k, v in self.params().items())

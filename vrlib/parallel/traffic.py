@@ -1,0 +1,324 @@
+"""The messages of one frame, sized from a real partition and a real view.
+
+Each function returns :class:`Messages` (source node, destination node, bytes), ready to be
+routed on a :class:`~vrlib.parallel.network.Network`. Object partitions send image fragments:
+a brick's local image is the pixels whose centres fall in the bounding rectangle of its
+projected box (what a renderer that tracks its footprint would send). Image partitions send
+voxels: a voxel goes to every screen tile whose rays can read it, that is every tile within
+the filter's reach of its projection.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["Messages", "footprint_rect", "object_fragments", "binary_swap", "gather",
+           "image_static", "image_dynamic", "swap_slots"]
+
+#: Most voxels projected when counting an image partition's traffic; larger volumes are
+#: counted on a sub-lattice whose every voxel stands for ``stride^3`` of them.
+MAX_PROJECTED = 1 << 24
+
+
+@dataclass(frozen=True)
+class Messages:
+    """One frame's messages; messages from a node to itself are dropped (they use no
+    channel) and repeated pairs are merged."""
+
+    src: np.ndarray
+    dst: np.ndarray
+    bytes: np.ndarray
+
+    @classmethod
+    def merged(cls, src, dst, size, nodes):
+        src = np.asarray(src, dtype=np.int64).ravel()
+        dst = np.asarray(dst, dtype=np.int64).ravel()
+        size = np.asarray(size, dtype=np.float64).ravel()
+        keep = (src != dst) & (size > 0)
+        key, where = np.unique(src[keep] * nodes + dst[keep], return_inverse=True)
+        total = np.bincount(where, size[keep], minlength=key.size)
+        return cls(key // nodes, key % nodes, total)
+
+    def __add__(self, other):
+        return Messages(np.concatenate([self.src, other.src]),
+                        np.concatenate([self.dst, other.dst]),
+                        np.concatenate([self.bytes, other.bytes]))
+
+    @property
+    def total(self):
+        """Bytes sent over the network in the frame."""
+        return float(self.bytes.sum())
+
+    def sent_per_node(self, nodes):
+        """Bytes each node sends."""
+        return np.bincount(self.src, self.bytes, minlength=nodes)
+
+
+def footprint_rect(view, lo, hi):
+    """Pixels ``(r0, r1, c0, c1)`` whose centres lie in the bounding rectangle of the
+    projected world box ``[lo, hi]`` (x, y, z), clipped to the image; empty when it misses.
+
+    Examples
+    --------
+    >>> from vrlib import View
+    >>> footprint_rect(View([0, 0, -1], up=[0, 1, 0], size=8, radius=1.0), [-1, -1, -1],
+    ...                [0, 0, 1])
+    (4, 8, 0, 4)
+    """
+    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1])
+                        for z in (lo[2], hi[2])], dtype=np.float64)
+    p = view.project(corners)
+    if not np.all(np.isfinite(p[:, :2])):
+        return (0, view.height, 0, view.width)  # reaches behind the eye: the whole screen
+    r0 = min(max(math.ceil(p[:, 0].min() - 0.5), 0), view.height)
+    r1 = min(max(math.floor(p[:, 0].max() - 0.5) + 1, 0), view.height)
+    c0 = min(max(math.ceil(p[:, 1].min() - 0.5), 0), view.width)
+    c1 = min(max(math.floor(p[:, 1].max() - 0.5) + 1, 0), view.width)
+    if r1 <= r0 or c1 <= c0:
+        return (0, 0, 0, 0)
+    return (r0, r1, c0, c1)
+
+
+def _area(rect):
+    r0, r1, c0, c1 = rect
+    return max(r1 - r0, 0) * max(c1 - c0, 0)
+
+
+def _intersect(a, b):
+    return (max(a[0], b[0]), min(a[1], b[1]), max(a[2], b[2]), min(a[3], b[3]))
+
+
+def _union(a, b):
+    if _area(a) == 0:
+        return b
+    if _area(b) == 0:
+        return a
+    return (min(a[0], b[0]), max(a[1], b[1]), min(a[2], b[2]), max(a[3], b[3]))
+
+
+def _tile_overlaps(tiles, rect):
+    """Owners and overlapping pixel counts of the tiles meeting ``rect``."""
+    r0, r1, c0, c1 = rect
+    if r1 <= r0 or c1 <= c0:
+        return np.zeros(0, np.int64), np.zeros(0)
+    i0 = np.searchsorted(tiles.rows, r0, side="right") - 1
+    i1 = np.searchsorted(tiles.rows, r1, side="left")
+    j0 = np.searchsorted(tiles.cols, c0, side="right") - 1
+    j1 = np.searchsorted(tiles.cols, c1, side="left")
+    h = np.minimum(r1, tiles.rows[i0 + 1:i1 + 1]) - np.maximum(r0, tiles.rows[i0:i1])
+    w = np.minimum(c1, tiles.cols[j0 + 1:j1 + 1]) - np.maximum(c0, tiles.cols[j0:j1])
+    return tiles.owner[i0:i1, j0:j1].ravel(), np.outer(h, w).ravel().astype(np.float64)
+
+
+def object_fragments(tree, owners, tiles, view, origin, spacing, *, bytes_per_pixel=4):
+    """Direct send: each brick's local image, cut by the screen tiles, goes to each tile's
+    owner.
+
+    Returns
+    -------
+    messages : Messages
+    local_pixels : ndarray
+        Pixels of each brick's local image (its footprint rectangle).
+    """
+    nodes = max(int(np.max(owners)) + 1, tiles.nodes)
+    src, dst, size, local = [], [], [], []
+    for brick in tree.bricks:
+        rect = footprint_rect(view, *brick.world_box(origin, spacing))
+        local.append(_area(rect))
+        who, pixels = _tile_overlaps(tiles, rect)
+        src.append(np.full(who.size, owners[brick.index]))
+        dst.append(who)
+        size.append(pixels * bytes_per_pixel)
+    return (Messages.merged(np.concatenate(src), np.concatenate(dst), np.concatenate(size),
+                            nodes), np.array(local, dtype=np.float64))
+
+
+def swap_slots(tree):
+    """Binary swap's slots: the subtrees at depth ``floor(log2 P)`` of the k-d tree, each one
+    brick or two (a pair folded together before the swap), left to right."""
+    depth = int(math.floor(math.log2(len(tree))))
+    slots = []
+
+    def visit(node, level):
+        if level == depth or not isinstance(node, tuple):
+            slots.append(node)
+            return
+        visit(node[2], level + 1)
+        visit(node[3], level + 1)
+
+    visit(tree.node, 0)
+    if len(slots) != 1 << depth:
+        raise ValueError("binary swap needs a k-d tree from vrlib.parallel.decompose.split "
+                         "(a perfect tree over its first floor(log2 P) levels)")
+    return slots
+
+
+def binary_swap(tree, view, origin, spacing, *, bytes_per_pixel=4, bounded=True):
+    """Binary swap (Ma et al. 1994) on the k-d tree's bricks, brick ``i`` on node ``i``.
+
+    Pairs folded into one slot first send the second brick's image to the first; then in
+    round ``r`` slot ``s`` swaps halves of its current screen region with slot ``s ^ 2^r``.
+    With ``bounded`` a node sends only the part of the half inside the bounding rectangle of
+    what its group has rendered; otherwise the whole half (the classic count, ``W^2 (1 - 1/P)``
+    per node).
+    """
+    slots = swap_slots(tree)
+    full = (0, view.height, 0, view.width)
+    rects = [footprint_rect(view, *b.world_box(origin, spacing)) for b in tree.bricks]
+    nodes = len(tree)
+    src, dst, size = [], [], []
+    leader, held = [], []
+    for slot in slots:
+        if isinstance(slot, tuple):
+            first, second = slot[2], slot[3]
+            src.append(second)
+            dst.append(first)
+            size.append(_area(rects[second] if bounded else full) * bytes_per_pixel)
+            leader.append(first)
+            held.append(_union(rects[first], rects[second]))
+        else:
+            leader.append(slot)
+            held.append(rects[slot])
+    region = [full] * len(slots)
+    for r in range(int(math.log2(len(slots)))):
+        new_held = list(held)
+        for s in range(len(slots)):
+            partner = s ^ (1 << r)
+            r0, r1, c0, c1 = region[s]
+            if r1 - r0 >= c1 - c0:
+                mid = (r0 + r1) // 2
+                halves = ((r0, mid, c0, c1), (mid, r1, c0, c1))
+            else:
+                mid = (c0 + c1) // 2
+                halves = ((r0, r1, c0, mid), (r0, r1, mid, c1))
+            keep, give = (halves[0], halves[1]) if s < partner else (halves[1], halves[0])
+            part = _intersect(give, held[s]) if bounded else give
+            src.append(leader[s])
+            dst.append(leader[partner])
+            size.append(_area(part) * bytes_per_pixel)
+            region[s] = keep
+            new_held[s] = _union(held[s], held[partner])
+        held = new_held
+    return Messages.merged(src, dst, size, nodes)
+
+
+def gather(tiles_or_regions, nodes, *, root=0, bytes_per_pixel=4):
+    """Every node's finished pixels to ``root`` (the display): ``tiles_or_regions`` is a
+    :class:`~vrlib.parallel.decompose.ScreenTiles` or a list of ``(node, rect)``."""
+    if hasattr(tiles_or_regions, "owner"):
+        t = tiles_or_regions
+        h = np.diff(t.rows)[:, None] * np.diff(t.cols)[None, :]
+        pixels = np.bincount(t.owner.ravel(), h.ravel().astype(float), minlength=nodes)
+        src = np.arange(nodes)
+    else:
+        src = np.array([n for n, _ in tiles_or_regions])
+        pixels = np.array([_area(r) for _, r in tiles_or_regions], dtype=float)
+    return Messages.merged(src, np.full(len(src), root), pixels * bytes_per_pixel, nodes)
+
+
+def _sub_lattice(sample_shape):
+    """Stride so that at most :data:`MAX_PROJECTED` voxels are projected."""
+    count = math.prod(sample_shape)
+    return max(1, math.ceil((count / MAX_PROJECTED) ** (1.0 / 3.0)))
+
+
+def _owned_samples(brick, sample_shape, stride):
+    """Global sample indices (per axis) a brick owns: its cells' lower corners, plus the
+    volume's last sample on its upper faces."""
+    axes = []
+    for lo, hi, n in zip(brick.lo, brick.hi, sample_shape, strict=True):
+        stop = n if hi == n - 1 else hi
+        first = -(-lo // stride) * stride
+        axes.append(np.arange(first, stop, stride))
+    return axes
+
+
+def _project_samples(view, axes, origin, spacing):
+    """Image coordinates and depths of the lattice points ``axes`` (z, y, x index arrays)."""
+    z, y, x = np.meshgrid(*axes, indexing="ij")
+    points = np.stack([x, y, z], axis=-1).reshape(-1, 3) * np.asarray(spacing) + origin
+    return view.project(points)
+
+
+def _reach_pixels(view, depth, reach):
+    """Filter reach ``reach`` (world units) in pixels at each ``depth``."""
+    if view.eye is None:
+        return np.full(depth.shape, reach / view.pixel_size)
+    return reach * view.distance / (view.pixel_size * np.maximum(depth, 1e-12))
+
+
+def image_static(tree, owners, tiles, view, sample_shape, origin, spacing, *, radius=1.0,
+                 bytes_per_voxel=1):
+    """Image partition, data fixed in bricks: each tile owner receives every voxel its rays
+    can read (within ``radius`` samples of a point on one of its rays) from the bricks'
+    owners.
+
+    Voxels are counted by projecting them; volumes of more than :data:`MAX_PROJECTED` samples
+    are counted on a regular sub-lattice, each sample standing for ``stride^3``.
+    """
+    stride = _sub_lattice(sample_shape)
+    reach = radius * float(np.linalg.norm(spacing))
+    nodes = max(int(np.max(owners)) + 1, tiles.nodes)
+    src, dst, size = [], [], []
+    for brick in tree.bricks:
+        axes = _owned_samples(brick, sample_shape, stride)
+        if any(a.size == 0 for a in axes):
+            continue
+        p = _project_samples(view, axes, origin, spacing)
+        rho = _reach_pixels(view, p[:, 2], reach)
+        # Tiles whose pixel centres come within the reach: tile rows i with
+        # rows[i] + 0.5 <= r + rho and rows[i + 1] - 0.5 >= r - rho.
+        i0 = np.clip(np.searchsorted(tiles.rows, p[:, 0] - rho + 0.5, side="right") - 1,
+                     0, len(tiles.rows) - 2)
+        i1 = np.clip(np.searchsorted(tiles.rows, p[:, 0] + rho - 0.5, side="right") - 1,
+                     0, len(tiles.rows) - 2)
+        j0 = np.clip(np.searchsorted(tiles.cols, p[:, 1] - rho + 0.5, side="right") - 1,
+                     0, len(tiles.cols) - 2)
+        j1 = np.clip(np.searchsorted(tiles.cols, p[:, 1] + rho - 0.5, side="right") - 1,
+                     0, len(tiles.cols) - 2)
+        seen = p[:, 0] + rho >= 0.5
+        seen &= p[:, 0] - rho <= view.height - 0.5
+        seen &= (p[:, 1] + rho >= 0.5) & (p[:, 1] - rho <= view.width - 0.5)
+        voxel = np.arange(p.shape[0])
+        keys = []
+        for di in range(int((i1 - i0).max(initial=0)) + 1):
+            for dj in range(int((j1 - j0).max(initial=0)) + 1):
+                hit = seen & (i0 + di <= i1) & (j0 + dj <= j1)
+                who = tiles.owner[(i0 + di)[hit], (j0 + dj)[hit]]
+                keys.append(voxel[hit] * nodes + who)
+        # A voxel that two tiles of one node need travels once.
+        who = np.unique(np.concatenate(keys)) % nodes
+        src.append(np.full(nodes, owners[brick.index]))
+        dst.append(np.arange(nodes))
+        size.append(np.bincount(who, minlength=nodes) * float(stride**3 * bytes_per_voxel))
+    return Messages.merged(np.concatenate(src), np.concatenate(dst), np.concatenate(size),
+                           nodes)
+
+
+def image_dynamic(tiles, before, after, sample_shape, origin, spacing, *, bytes_per_voxel=1):
+    """Image partition, data migrating with the view: each voxel lives on the owner of the
+    tile its centre projects into, and moves when the view changes from ``before`` to
+    ``after``. (Filter borders are left out: the voxels near a tile's edge that both nodes
+    need.)"""
+    stride = _sub_lattice(sample_shape)
+    nodes = tiles.nodes
+    src, dst, size = [], [], []
+    for z0 in range(0, sample_shape[0], 16 * stride):
+        axes = [np.arange(z0, min(z0 + 16 * stride, sample_shape[0]), stride),
+                np.arange(0, sample_shape[1], stride), np.arange(0, sample_shape[2], stride)]
+        owner = []
+        for view in (before, after):
+            p = _project_samples(view, axes, origin, spacing)
+            i = np.clip(np.searchsorted(tiles.rows, p[:, 0], side="right") - 1, 0,
+                        len(tiles.rows) - 2)
+            j = np.clip(np.searchsorted(tiles.cols, p[:, 1], side="right") - 1, 0,
+                        len(tiles.cols) - 2)
+            owner.append(tiles.owner[i, j])
+        src.append(owner[0])
+        dst.append(owner[1])
+        size.append(np.full(owner[0].size, float(stride**3 * bytes_per_voxel)))
+    return Messages.merged(np.concatenate(src), np.concatenate(dst), np.concatenate(size),
+                           nodes)
