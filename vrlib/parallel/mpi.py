@@ -438,7 +438,8 @@ def _visible_work(comm, lattice, read, tree, rank, filt, transfer, value_range, 
         work[tuple(index)] = math.prod(cells)
     total = np.empty_like(work)
     comm.Allreduce(work, total, op=MPI.SUM)
-    sent["balance"] += work.nbytes
+    if comm.Get_size() > 1:
+        sent["balance"] += work.nbytes
     return total
 
 
