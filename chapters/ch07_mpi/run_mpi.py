@@ -1,0 +1,121 @@
+"""The MPI renderer on this machine: equality with the serial render, bytes sent against the
+traffic model, load balance on sparse and dense scenes, and timings at 1 and 2 ranks with the
+model's prediction for larger machines.
+
+Every run starts ``mpiexec`` from the environment (the MPICH wheel) on
+:mod:`chapters.ch07_mpi._frame`, with one numba thread per rank so that two ranks on the two
+cores do not compete for them. Writes ``build/results/ch07_mpi/mpi.json``.
+"""
+
+import json
+import math
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from chapters.common import ROOT, by_profile, progress, result_path, write_json
+from vrlib import View
+from vrlib.parallel import decompose, traffic
+
+MPIEXEC = Path(sys.executable).parent / "mpiexec"
+DENSE = {"field": "marschner-lobb", "params": {}}
+SPARSE = {"field": "random-blobs", "params": {"count": 6, "seed": 7}}
+ORBIT = {"azimuth": 35.0, "elevation": 25.0}
+RAMP = {"threshold": 0.25, "scale": 8.0}
+ALL_CASES = [["binary-swap", "even"], ["direct-send", "even"], ["direct-send", "interleaved"],
+             ["binary-swap", "work"], ["image", None]]
+EQUALITY = {"n": by_profile(49, 97), "size": by_profile(96, 192)}
+BALANCE = {"n": by_profile(65, 129), "size": by_profile(128, 256), "ranks": [4, 8]}
+TIMING = {"n": by_profile(129, 257), "size": by_profile(256, 512), "repeats": 3}
+PREDICT = [2, 4, 8, 16, 64, 256, 1024]
+PIXEL_BYTES = 32  # float64 RGBA, as the renderer sends them
+
+
+def launch(ranks, config):
+    env = dict(os.environ, NUMBA_NUM_THREADS="1")
+    done = subprocess.run([str(MPIEXEC), "-n", str(ranks), sys.executable, "-m",
+                           "chapters.ch07_mpi._frame", json.dumps(config)], cwd=ROOT, env=env,
+                          capture_output=True, text=True, timeout=900, check=False)
+    if done.returncode != 0:
+        raise SystemExit(f"mpiexec -n {ranks} failed:\n{done.stderr[-3000:]}")
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def simulated_bytes(ranks, n, size):
+    """The traffic module's bytes per rank for direct send and bounded binary swap (float64
+    pixels), and for the image partition (float64 voxels, the trilinear filter's reach)."""
+    view = View.orbit(size=size, **ORBIT)
+    origin, spacing = np.array([-1.0, -1.0, -1.0]), np.full(3, 2.0 / (n - 1))
+    tree = decompose.split((n - 1,) * 3, ranks)
+    tiles = decompose.screen_tiles(size, size, ranks)
+    direct, _ = traffic.object_fragments(tree, np.arange(ranks), tiles, view, origin, spacing,
+                                         bytes_per_pixel=PIXEL_BYTES)
+    swap = traffic.binary_swap(tree, view, origin, spacing, bytes_per_pixel=PIXEL_BYTES)
+    image = traffic.image_static(tree, np.arange(ranks), tiles, view, (n,) * 3, origin,
+                                 spacing, radius=1.0, bytes_per_voxel=8)
+    return {"direct-send": direct.sent_per_node(ranks).tolist(),
+            "binary-swap": swap.sent_per_node(ranks).tolist(),
+            "image": image.sent_per_node(ranks).tolist()}
+
+
+def main():
+    if not MPIEXEC.exists():
+        raise SystemExit(f"mpiexec missing from the environment: {MPIEXEC}")
+    equality = []
+    for ranks in progress(range(1, 9), "ranks 1-8"):
+        report = launch(ranks, {**DENSE, **RAMP, "n": EQUALITY["n"], "size": EQUALITY["size"],
+                                "orbit": ORBIT, "cases": ALL_CASES, "check": True})
+        equality.append({"ranks": ranks, "cases": report["cases"],
+                         "simulated": simulated_bytes(ranks, EQUALITY["n"], EQUALITY["size"])})
+    balance = []
+    for name, field in progress([("dense", DENSE), ("sparse", SPARSE)], "balance"):
+        for ranks in BALANCE["ranks"]:
+            report = launch(ranks, {**field, **RAMP, "n": BALANCE["n"],
+                                    "size": BALANCE["size"], "orbit": ORBIT, "repeats": 2,
+                                    "cases": [["direct-send", "even"],
+                                              ["direct-send", "interleaved"],
+                                              ["direct-send", "work"]]})
+            balance.append({"scene": name, "ranks": ranks, "cases": report["cases"]})
+    timing = []
+    for ranks in progress([1, 2], "timing"):
+        report = launch(ranks, {**DENSE, **RAMP, "n": TIMING["n"], "size": TIMING["size"],
+                                "orbit": ORBIT, "repeats": TIMING["repeats"],
+                                "cases": [["binary-swap", "even"], ["direct-send", "even"]]})
+        timing.append({"ranks": ranks, "cases": report["cases"]})
+    write_json(result_path(__file__, "mpi.json"), {
+        "equality": equality, "balance": balance, "timing": timing,
+        "prediction": predict(timing), "settings": {
+            "equality": EQUALITY, "balance": BALANCE, "timing": TIMING, "orbit": ORBIT,
+            "ramp": RAMP, "dense": DENSE, "sparse": SPARSE}})
+
+
+def predict(timing):
+    """Frame time at larger P from the measured costs: the 1-rank frame (sampling the field,
+    ray casting, everything but communication) divided evenly over P ranks, plus binary swap's
+    bounded bytes for the busiest rank at that P (traffic module) at the compositing rate
+    measured with 2 ranks (bytes sent over seconds spent compositing)."""
+    single = timing[0]["cases"][0]["seconds"]
+    two = timing[1]["cases"][0]["ranks"]
+    moved = sum(r["bytes"]["composite"] for r in two)
+    spent = sum(r["composite_s"] for r in two)
+    rate = moved / spent if spent > 0 else math.inf
+    n, size = TIMING["n"], TIMING["size"]
+    view = View.orbit(size=size, **ORBIT)
+    origin, spacing = np.array([-1.0, -1.0, -1.0]), np.full(3, 2.0 / (n - 1))
+    rows = []
+    for p in PREDICT:
+        tree = decompose.split((n - 1,) * 3, p)
+        swap = traffic.binary_swap(tree, view, origin, spacing, bytes_per_pixel=PIXEL_BYTES)
+        busiest = float(swap.sent_per_node(p).max())
+        work = single / p
+        rows.append({"ranks": p, "work_s": work, "composite_s": busiest / rate,
+                     "frame_s": work + busiest / rate,
+                     "speedup": single / (work + busiest / rate)})
+    return {"single_rank_s": single, "bytes_per_second": rate, "rows": rows}
+
+
+if __name__ == "__main__":
+    main()
