@@ -13,7 +13,9 @@ import vrlib
 MODULES = [
     "vrlib.volume", "vrlib.filters", "vrlib.transfer", "vrlib.view", "vrlib.compositing",
     "vrlib.image", "vrlib.metrics", "vrlib.bounds", "vrlib.cost", "data_gen", "data_gen.fields",
-    "data_gen.loaders",
+    "data_gen.loaders", "vrlib.parallel.taxonomy", "vrlib.parallel.decompose",
+    "vrlib.parallel.model", "vrlib.parallel.network", "vrlib.parallel.traffic",
+    "vrlib.parallel.mpi",
 ]
 # Abstract bases: their subclasses carry the examples.
 ABSTRACT = {"Filter", "TransferFunction", "Field"}

@@ -134,12 +134,25 @@ def main():
             exponents[key] = {stat: fit([r["nodes"] for r in sel], [r[stat] for r in sel])
                               for stat in ("total", "max", "mean", "bisection")}
             exponents[key]["range"] = [sel[0]["nodes"], sel[-1]["nodes"]]
-    slowest = max(r["seconds"] for r in rows)
+    slowest = max(r["seconds"] for r in rows) / len(VIEWS)
+    largest = [r for r in rows if r["nodes"] == max(NODES) and not r["torus"]]
+    lowest = min(largest, key=lambda r: r["max"])["class"]
+    timing = {r["class"]: r["seconds"] / len(VIEWS) for r in largest}
+
+    def total(name, nodes):
+        return next(r["total"] for r in rows if r["class"] == name and r["nodes"] == nodes
+                    and not r["torus"])
+
+    crossover = next((p for p in NODES if total("image static", p) > total("object blocks", p)),
+                     None)
+    interleave_ratio = total("object blocks interleaved", 64) / total("object blocks", 64)
     write_json(result_path(__file__, "network.json"), {
         "width": WIDTH, "voxels_per_node": VOXELS_PER_NODE, "pixel_bytes": PIXEL_BYTES,
         "voxel_bytes": VOXEL_BYTES, "radius": RADIUS, "interleave": INTERLEAVE, "turn": TURN,
         "views": VIEWS, "classes": CLASSES, "rows": rows, "exponents": exponents,
-        "slowest_frame_seconds": slowest,
+        "slowest_frame_seconds": slowest, "seconds_at_largest": timing,
+        "lowest_busiest_at_largest": lowest, "image_static_exceeds_blocks_at": crossover,
+        "interleave_ratio": interleave_ratio,
         "largest": max(NODES),
     })
 

@@ -39,7 +39,7 @@ def main():
         middle.bar(np.arange(len(groups)) + (i - 1) * width, values, width,
                    label="work-sized k-d split (new)" if balance == "work" else balance)
     middle.axhline(1.0, color="0.5", lw=0.8)
-    middle.set_xticks(range(len(groups)), [f"{s}, {p} ranks" for s, p in groups])
+    middle.set_xticks(range(len(groups)), [f"{s}\n{p} ranks" for s, p in groups])
     middle.set_ylabel("max / mean ray samples per rank")
     middle.set_title("Load imbalance (1 is perfect)", fontsize=10)
     middle.legend(fontsize=8)

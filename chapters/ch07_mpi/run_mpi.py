@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+import data_gen
 from chapters.common import ROOT, by_profile, progress, result_path, write_json
 from vrlib import View
 from vrlib.parallel import decompose, traffic
@@ -85,11 +86,42 @@ def main():
                                 "orbit": ORBIT, "repeats": TIMING["repeats"],
                                 "cases": [["binary-swap", "even"], ["direct-send", "even"]]})
         timing.append({"ranks": ranks, "cases": report["cases"]})
+    prediction = predict(timing)
     write_json(result_path(__file__, "mpi.json"), {
         "equality": equality, "balance": balance, "timing": timing,
-        "prediction": predict(timing), "settings": {
+        "prediction": prediction, "summary": summarise(equality, balance, timing, prediction),
+        "settings": {
             "equality": EQUALITY, "balance": BALANCE, "timing": TIMING, "orbit": ORBIT,
             "ramp": RAMP, "dense": DENSE, "sparse": SPARSE}})
+
+
+def summarise(equality, balance, timing, prediction):
+    """The numbers the report quotes."""
+    worst = max(c["difference"] for e in equality for c in e["cases"])
+    ratios = []
+    for e in equality[1:]:
+        for key in ("direct-send", "binary-swap"):
+            case = next(c for c in e["cases"] if c["compositing"] == key
+                        and c["balance"] == "even")
+            sent = np.array([r["bytes"]["composite"] for r in case["ranks"]], dtype=float)
+            simulated = np.array(e["simulated"][key])
+            ratios.append(float(sent.sum() / simulated.sum()))
+    imbalance = {}
+    for b in balance:
+        for case in b["cases"]:
+            samples = np.array([r["samples"] for r in case["ranks"]], dtype=float)
+            imbalance[f"{b['scene']} {b['ranks']} {case['balance']}"] = float(
+                samples.max() / samples.mean())
+    visible = {}
+    for name, scene in (("dense", DENSE), ("sparse", SPARSE)):
+        samples = data_gen.make_field(scene["field"], **scene["params"]).sample(BALANCE["n"])
+        visible[name] = float((samples.data > RAMP["threshold"]).mean())
+    t1, t2 = timing[0]["cases"][0]["seconds"], timing[1]["cases"][0]["seconds"]
+    two = next(r for r in prediction["rows"] if r["ranks"] == 2)
+    return {"max_difference": worst, "sent_over_simulated": [min(ratios), max(ratios)],
+            "imbalance": imbalance, "t1": t1, "t2": t2, "speedup": t1 / t2,
+            "efficiency": t1 / t2 / 2, "model_t2": two["frame_s"],
+            "rate_mb_s": prediction["bytes_per_second"] / 1e6, "visible": visible}
 
 
 def predict(timing):

@@ -2,9 +2,10 @@
 
 Run as ``mpiexec -n P python render.py CONFIG_JSON``. CONFIG holds ``field`` (a data_gen name),
 ``params``, ``n`` (samples per axis), ``size`` (image), ``views`` (orbit keyword dicts),
-``filters`` and ``cases`` (``[compositing, balance]`` pairs, or ``["image", null]``). Rank 0
-prints one JSON line: per case, the largest difference from the serial render, the bytes each
-rank sent per phase, and the samples per rank.
+``filters`` and ``cases`` (``[compositing, balance]`` pairs, or ``["image", null]``); the
+transfer function is ``Glow(glow)``, or with ``threshold`` a ramp that is transparent below it.
+Rank 0 prints one JSON line: per case, the largest difference from the serial render, the
+bytes each rank sent per phase, and the samples per rank.
 """
 
 import json
@@ -21,6 +22,10 @@ from vrlib.parallel import mpi
 def main(comm, config):
     field = data_gen.make_field(config["field"], **config.get("params", {}))
     transfer = vrlib.Glow(config.get("glow", 2.0))
+    if "threshold" in config:
+        values = np.linspace(0.0, 1.0, 257)
+        t = config["threshold"]
+        transfer = vrlib.LookupTransfer(8.0 * np.clip((values - t) / (1 - t), 0.0, 1.0))
     results = []
     for orbit in config["views"]:
         view = vrlib.View.orbit(size=config["size"], **orbit)

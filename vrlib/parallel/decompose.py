@@ -28,7 +28,14 @@ SHAPES = {"slabs": (0,), "shafts": (1, 2), "blocks": (0, 1, 2)}
 @dataclass(frozen=True)
 class Brick:
     """Cells ``[lo, hi)`` (z, y, x) of the global lattice, and the brick's place in the
-    k-d tree (``index``, in the tree's left-to-right order)."""
+    k-d tree (``index``, in the tree's left-to-right order).
+
+    Examples
+    --------
+    >>> b = Brick(0, (0, 0, 0), (4, 8, 8))
+    >>> b.cells, b.samples(1, (17, 17, 17))
+    ((4, 8, 8), ((0, 6), (0, 10), (0, 10)))
+    """
 
     index: int
     lo: tuple
@@ -58,6 +65,14 @@ class KdTree:
 
     ``node`` is a nested tuple: a leaf is a brick index, an inner node
     ``(axis, position, left, right)`` with ``left`` holding the cells below ``position``.
+
+    Examples
+    --------
+    >>> from vrlib import View
+    >>> tree = split((8, 8, 8), 2)                     # cut along z at cell 4
+    >>> up = View.orbit(elevation=-60, size=8)         # looking up: low z is nearer
+    >>> tree.order(up, origin=(-1, -1, -1), spacing=(0.25, 0.25, 0.25))
+    [0, 1]
     """
 
     bricks: tuple
@@ -151,19 +166,21 @@ def split(cells, parts, *, shape="blocks", weights=None, grid=None):
         Which axes may be cut.
     weights : ndarray of shape ``cells``, optional
         Work per cell. Each split is placed so that the work on either side is in proportion
-        to the bricks it will hold (the load balance of :mod:`vrlib.parallel.balance`);
+        to the bricks it will hold (the work-sized split of :mod:`vrlib.parallel.mpi`);
         default: split the cells themselves evenly.
     grid : (int, int, int), optional
         Cut a regular grid with this many bricks per axis instead (product ``parts``).
-
-    The tree halves the count at every level (``n -> n // 2, n - n // 2``), cutting the
-    longest allowed axis, so that its first ``floor(log2 parts)`` levels form a perfect binary
-    tree: what binary-swap compositing needs.
 
     Raises
     ------
     ValueError
         More bricks than cells along an axis (each brick needs at least one cell).
+
+    Notes
+    -----
+    The tree halves the count at every level (``n`` into ``n // 2`` and ``n - n // 2``),
+    cutting the longest allowed axis, so that its first ``floor(log2 parts)`` levels form a
+    perfect binary tree: what binary-swap compositing needs.
 
     Examples
     --------
@@ -264,6 +281,12 @@ class ScreenTiles:
 
     ``rows`` and ``cols`` are the tile boundaries (pixel indices, first 0, last the image
     size); ``owner[i, j]`` the node owning tile ``(i, j)``.
+
+    Examples
+    --------
+    >>> tiles = screen_tiles(8, 8, 2)
+    >>> tiles.rects(1), tiles.overlaps((2, 6, 0, 8))
+    ([(0, 8, 4, 8)], [(0, 0, 16), (0, 1, 16)])
     """
 
     rows: np.ndarray

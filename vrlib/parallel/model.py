@@ -38,7 +38,14 @@ def projected_area(sides, direction=None):
 
 def box_rect_area(sides, right, up):
     """Area of the bounding rectangle of a box's orthographic projection onto the image axes
-    ``right`` and ``up`` (what a renderer that sends bounding rectangles sends)."""
+    ``right`` and ``up`` (what a renderer that sends bounding rectangles sends).
+
+    Examples
+    --------
+    >>> r, u = [0.6, 0.8, 0.0], [0.0, 0.0, 1.0]
+    >>> round(box_rect_area((1, 1, 1), r, u), 6)        # (0.6 + 0.8) x 1
+    1.4
+    """
     s = np.asarray(sides, float)
     return float((s @ np.abs(right)) * (s @ np.abs(up)))
 
@@ -61,6 +68,12 @@ def object_frame(grid, *, side, pixel, bytes_per_pixel=4, view=None):
     -------
     (per_node, total) : (float, float)
         Bytes.
+
+    Examples
+    --------
+    >>> per_node, total = object_frame((4, 4, 4), side=2.0, pixel=2.0 / 512)
+    >>> round(per_node / 4 / 512**2, 4)     # 1.5 / 64^(2/3) x (1 - 1/64) of the image
+    0.0923
     """
     nodes = math.prod(grid)
     sides = _brick_sides(side, grid)
@@ -73,7 +86,13 @@ def object_frame(grid, *, side, pixel, bytes_per_pixel=4, view=None):
 
 
 def binary_swap_frame(nodes, width, height, *, bytes_per_pixel=4):
-    """Binary swap with full-screen images: ``W H (1 - 1/P)`` bytes per node."""
+    """Binary swap with full-screen images: ``W H (1 - 1/P)`` bytes per node.
+
+    Examples
+    --------
+    >>> binary_swap_frame(4, 512, 512)[0] / (4 * 512 * 512)
+    0.75
+    """
     per_node = width * height * bytes_per_pixel * (1.0 - 1.0 / nodes)
     return per_node, per_node * nodes
 
@@ -84,6 +103,11 @@ def image_static_frame(nodes, samples, *, tile, reach=0.0, bytes_per_voxel=1):
     border of ``reach`` pixels (the filter's reach), ``(1 + 2 reach / tile)^2`` of its share.
 
     Returns bytes ``(per_node, total)``.
+
+    Examples
+    --------
+    >>> round(image_static_frame(64, 256**3, tile=64, reach=2)[1] / 256**3, 6)  # 1.0625^2 x 63/64
+    1.111267
     """
     border = (1.0 + 2.0 * reach / tile) ** 2
     total = samples * border * (1.0 - 1.0 / nodes) * bytes_per_voxel
@@ -100,6 +124,14 @@ def image_dynamic_frame(nodes, samples, *, dtheta, depth, tile_width, pixel,
     ``N^3 dtheta / (4 sqrt(P))`` per node.
 
     Returns bytes ``(per_node, total)``.
+
+    Examples
+    --------
+    >>> import math
+    >>> per_node, _ = image_dynamic_frame(64, 512**3, dtheta=math.radians(1), depth=2.0,
+    ...                                   tile_width=64, pixel=2.0 / 512)
+    >>> round(per_node / (512**3 / 64), 4)   # share of a node's voxels that move
+    0.0349
     """
     shift = depth * abs(dtheta) / 4.0 / pixel
     per_node = samples / nodes * min(1.0, shift / tile_width) * bytes_per_voxel
@@ -131,6 +163,12 @@ def channel_loads(total, nodes, *, torus=False):
     traffic crosses the middle cut, half of that each way, over its ``2 Y`` directed
     channels, ``4 Y`` on a torus). The brief counts a link's two directions together, which
     doubles its figures against these.
+
+    Examples
+    --------
+    >>> loads = channel_loads(1e6, 64)
+    >>> loads["bisection"], round(loads["mean"])
+    (31250.0, 23438)
     """
     _validate.positive_int("nodes", nodes)
     x, y = mesh_shape(nodes)

@@ -53,7 +53,8 @@ from vrlib.skipping import filter_margin, lattice_sums
 from vrlib.transfer import Glow, TransferFunction
 from vrlib.view import View
 
-__all__ = ["render_object", "render_image", "RankFailed", "Frame", "COMPOSITING", "BALANCE"]
+__all__ = ["render_object", "render_image", "RankFailed", "Frame", "visible_cells",
+           "work_split", "COMPOSITING", "BALANCE"]
 
 COMPOSITING = ("direct-send", "binary-swap")
 BALANCE = ("even", "interleaved", "work")
@@ -62,7 +63,14 @@ HEADER = 32
 
 
 class RankFailed(RuntimeError):
-    """Another rank raised during a distributed render."""
+    """Another rank raised during a distributed render.
+
+    Examples
+    --------
+    >>> error = RankFailed(2, "reading its bricks", "OSError: disk gone")
+    >>> str(error), error.rank
+    ('rank 2 failed while reading its bricks: OSError: disk gone', 2)
+    """
 
     def __init__(self, rank, stage, message):
         super().__init__(f"rank {rank} failed while {stage}: {message}")
@@ -99,6 +107,13 @@ class Frame:
     ``ranks`` (root only) one dict per rank: bricks, samples, seconds rendering and
     compositing, and bytes sent per phase (``balance``, ``voxels``, ``composite``,
     ``gather``).
+
+    Examples
+    --------
+    >>> frame = Frame(None, [{"samples": 30, "bytes": {"composite": 8}},
+    ...                      {"samples": 10, "bytes": {"composite": 4}}])
+    >>> frame.imbalance(), frame.bytes_sent("composite").tolist()
+    (1.5, [8.0, 4.0])
     """
 
     image: Image | None
@@ -192,13 +207,12 @@ def _value_range(comm, lows, highs, filt):
             max(centre * s_min, centre * s_max) + a_max * half)
 
 
-def _empty_blocks(data, first, lo, hi, lattice, filt, transfer):
+def _empty_blocks(data, first, lo, hi, cells, filt, transfer):
     """Empty-space grid (global blocks of :data:`BLOCK` cells) for the samples a brick takes:
     a block is marked empty when nothing in its part of the brick (plus the filter's margin)
     can show; blocks outside the brick are marked empty, since the brick takes no samples
     there."""
-    nblocks = [-(-c // BLOCK) for c in lattice.cells]
-    empty = np.ones(nblocks, dtype=bool)
+    empty = np.ones([-(-c // BLOCK) for c in cells], dtype=bool)
     margin = filter_margin(filt)
     s_min, s_max, a_max = lattice_sums(filt)
     b0 = [lo[a] // BLOCK for a in range(3)]
@@ -224,7 +238,7 @@ def _empty_blocks(data, first, lo, hi, lattice, filt, transfer):
 def _cast(data, first, brick_lo, brick_hi, lattice, view, filt, transfer, ds, value_range,
           pixels=None):
     """Ray-cast one brick's samples; ``pixels`` restricts the rays to a mask."""
-    empty = _empty_blocks(data, first, brick_lo, brick_hi, lattice, filt, transfer)
+    empty = _empty_blocks(data, first, brick_lo, brick_hi, lattice.cells, filt, transfer)
     mask = footprint_mask(view, lattice, empty, BLOCK) if not empty.all() else \
         np.zeros(view.shape, dtype=bool)
     if pixels is not None:
@@ -424,31 +438,66 @@ def _check(comm, view, filter, transfer, step, compositing=None, balance=None,
     return filt, transfer, step
 
 
-def _visible_work(comm, lattice, read, tree, rank, filt, transfer, value_range, sent):
-    """Visible volume (cells in blocks that can show) per global block, summed over ranks."""
-    brick = tree.bricks[rank]
-    region = brick.samples(_ghost(filt), lattice.shape)
-    data = read(region)
-    first = [a for a, _ in region]
-    empty = _empty_blocks(data, first, brick.lo, brick.hi, lattice, filt, transfer)
+def visible_cells(data, first, lo, hi, shape, *, filter="trilinear", transfer=None):
+    """Cells of the brick ``[lo, hi)`` that lie in blocks which can show, per global block of
+    :data:`vrlib.raycast.BLOCK` cells: one rank's share of the work map that the work-sized
+    split sums over the ranks.
+
+    ``data`` holds the samples from global index ``first`` (z, y, x) on, covering the brick
+    and the filter's margin; ``shape`` is the volume's sample shape. For a whole volume pass
+    ``first = lo = (0, 0, 0)`` and ``hi`` its cells: the serial twin of the summed map.
+
+    Examples
+    --------
+    >>> from vrlib import LookupTransfer
+    >>> data = np.zeros((17, 17, 17)); data[12, 12, 12] = 1.0
+    >>> ramp = LookupTransfer([0.0, 0.0, 1.0], value_range=(0.0, 1.0))  # 0 up to 0.5
+    >>> visible_cells(data, (0, 0, 0), (0, 0, 0), (16, 16, 16), data.shape,
+    ...               transfer=ramp).tolist()
+    [[[0.0, 0.0], [0.0, 0.0]], [[0.0, 0.0], [0.0, 512.0]]]
+    """
+    filt = make_filter(filter)
+    transfer = Glow(1.0) if transfer is None else transfer
+    cells = tuple(n - 1 for n in shape)
+    empty = _empty_blocks(data, first, lo, hi, cells, filt, transfer)
     work = np.zeros(empty.shape)
     for index in np.argwhere(~empty):
-        cells = [min((i + 1) * BLOCK, h) - max(i * BLOCK, lo)
-                 for i, lo, h in zip(index, brick.lo, brick.hi, strict=True)]
-        work[tuple(index)] = math.prod(cells)
+        share = [min((i + 1) * BLOCK, h) - max(i * BLOCK, low)
+                 for i, low, h in zip(index, lo, hi, strict=True)]
+        work[tuple(index)] = math.prod(share)
+    return work
+
+
+def work_split(block_work, cells, parts):
+    """The work-sized k-d split: ``parts`` bricks of ``cells`` (z, y, x), each side of every
+    cut holding visible volume (``block_work``, per block) in proportion to its bricks. A
+    small floor (1% of the densest block's per-cell weight) keeps empty regions from being
+    free, since rays still cross them.
+
+    Examples
+    --------
+    >>> work = np.zeros((2, 2, 2)); work[1, 1, 1] = 512.0     # all in one corner block
+    >>> [b.hi for b in work_split(work, (16, 16, 16), 2).bricks]   # the cut moves to it
+    [(12, 16, 16), (16, 16, 16)]
+    """
+    per_cell = block_work / BLOCK**3
+    weights = per_cell.repeat(BLOCK, 0).repeat(BLOCK, 1).repeat(BLOCK, 2)
+    weights = weights[: cells[0], : cells[1], : cells[2]]
+    weights = weights + 0.01 * max(float(weights.max()), 1e-300)
+    return split(cells, parts, weights=weights)
+
+
+def _visible_work(comm, lattice, read, tree, rank, filt, transfer, sent):
+    """The work map summed over the ranks (one allreduce)."""
+    brick = tree.bricks[rank]
+    region = brick.samples(_ghost(filt), lattice.shape)
+    work = visible_cells(read(region), [a for a, _ in region], brick.lo, brick.hi,
+                         lattice.shape, filter=filt, transfer=transfer)
     total = np.empty_like(work)
     comm.Allreduce(work, total, op=MPI.SUM)
     if comm.Get_size() > 1:
         sent["balance"] += work.nbytes
     return total
-
-
-def _cell_weights(block_work, cells):
-    """Per-cell weights from per-block visible volume (plus a floor for traversal)."""
-    per_cell = block_work / BLOCK**3
-    weights = per_cell.repeat(BLOCK, 0).repeat(BLOCK, 1).repeat(BLOCK, 2)
-    weights = weights[: cells[0], : cells[1], : cells[2]]
-    return weights + 0.01 * max(float(weights.max()), 1e-300)
 
 
 def render_object(comm, source, view, *, shape=None, extent=None, filter="trilinear",
@@ -489,6 +538,19 @@ def render_object(comm, source, view, *, shape=None, extent=None, filter="trilin
         give along the cut axes.
     RankFailed
         Another rank raised.
+
+    Examples
+    --------
+    Run under ``mpiexec -n P python script.py``; with one rank it is the serial render:
+
+    >>> from mpi4py import MPI
+    >>> import data_gen, vrlib
+    >>> field = data_gen.make_field("gaussian-blob", sigma=0.4)
+    >>> view = vrlib.View.orbit(azimuth=30, elevation=20, size=16)
+    >>> frame = render_object(MPI.COMM_WORLD, field, view, shape=17)
+    >>> serial = vrlib.render(field.sample(17), view, early_termination=1.0)
+    >>> bool(abs(frame.image.rgba - serial.rgba).max() < 1e-12)
+    True
     """
     size, rank = comm.Get_size(), comm.Get_rank()
     sent = {"balance": 0, "voxels": 0, "composite": 0, "gather": 0}
@@ -512,9 +574,8 @@ def render_object(comm, source, view, *, shape=None, extent=None, filter="trilin
                                [float(d.max()) for *_, d in bricks], filt)
     if balance == "work":
         with _Stage(comm, "measuring its visible volume"):
-            block_work = _visible_work(comm, lattice, read, tree, rank, filt, transfer,
-                                       value_range, sent)
-        tree = split(lattice.cells, size, weights=_cell_weights(block_work, lattice.cells))
+            block_work = _visible_work(comm, lattice, read, tree, rank, filt, transfer, sent)
+        tree = work_split(block_work, lattice.cells, size)
         with _Stage(comm, "reading its re-balanced brick"):
             brick = tree.bricks[rank]
             region = brick.samples(_ghost(filt), lattice.shape)
@@ -589,6 +650,16 @@ def render_image(comm, source, view, *, shape=None, extent=None, filter="triline
     (within the filter's reach of the tile), assembles them, and ray-casts its tile.
     Arguments as :func:`render_object`. Returns a :class:`Frame` whose ranks count the voxel
     traffic under ``bytes["voxels"]``.
+
+    Examples
+    --------
+    >>> from mpi4py import MPI
+    >>> import data_gen, vrlib
+    >>> field = data_gen.make_field("marschner-lobb")
+    >>> view = vrlib.View.orbit(azimuth=30, elevation=20, size=16)
+    >>> frame = render_image(MPI.COMM_WORLD, field, view, shape=17, filter="catmull-rom")
+    >>> frame.image.shape, frame.ranks[0]["bytes"]["voxels"]   # one rank: nothing to send
+    ((16, 16), 0)
     """
     size, rank = comm.Get_size(), comm.Get_rank()
     sent = {"balance": 0, "voxels": 0, "composite": 0, "gather": 0}

@@ -41,6 +41,12 @@ class ChannelLoad:
     ``west[y, x]``: the reverse direction of the same link; ``north[x, y]`` and ``south[x, y]``
     likewise along column ``x``. Links a mesh does not have hold zero and are left out of the
     statistics.
+
+    Examples
+    --------
+    >>> load = Network(3, 1).route([0, 2], [2, 0], [5.0, 1.0])
+    >>> load.max, load.mean, load.total
+    (5.0, 3.0, 12.0)
     """
 
     east: np.ndarray
@@ -123,6 +129,7 @@ class Network:
 
     @property
     def nodes(self):
+        """Number of nodes."""
         return self.columns * self.rows
 
     def __repr__(self):

@@ -59,13 +59,20 @@ class Partition:
 
     @property
     def name(self):
+        """The class as ``space / shape / layout / schedule``."""
         return f"{self.space} / {self.shape} / {self.layout} / {self.schedule}"
 
 
 def communication(partition):
     """What one frame sends for a class, and how it grows (``W^2`` image, ``N^3`` voxels,
     ``P`` nodes, ``k`` regions per node, ``dtheta`` the turn per frame); the exact counts are
-    :mod:`vrlib.parallel.model` and :mod:`vrlib.parallel.traffic`."""
+    :mod:`vrlib.parallel.model` and :mod:`vrlib.parallel.traffic`.
+
+    Examples
+    --------
+    >>> communication(Partition("object", "blocks"))[1]
+    'local image 1.5 W^2 / P^(2/3) per node, 1.5 W^2 P^(1/3) in total'
+    """
     p = partition
     if p.space == "image":
         if p.schedule == "static":

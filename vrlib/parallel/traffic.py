@@ -26,7 +26,14 @@ MAX_PROJECTED = 1 << 24
 @dataclass(frozen=True)
 class Messages:
     """One frame's messages; messages from a node to itself are dropped (they use no
-    channel) and repeated pairs are merged."""
+    channel) and repeated pairs are merged.
+
+    Examples
+    --------
+    >>> m = Messages.merged([0, 0, 1, 2], [1, 1, 1, 0], [3.0, 4.0, 9.0, 2.0], nodes=3)
+    >>> m.src.tolist(), m.dst.tolist(), m.bytes.tolist(), m.sent_per_node(3).tolist()
+    ([0, 2], [1, 0], [7.0, 2.0], [7.0, 0.0, 2.0])
+    """
 
     src: np.ndarray
     dst: np.ndarray
@@ -122,6 +129,18 @@ def object_fragments(tree, owners, tiles, view, origin, spacing, *, bytes_per_pi
     messages : Messages
     local_pixels : ndarray
         Pixels of each brick's local image (its footprint rectangle).
+
+    Examples
+    --------
+    >>> from vrlib import View
+    >>> from vrlib.parallel.decompose import screen_tiles, split
+    >>> view = View([0, 0, -1], up=[0, 1, 0], size=8, radius=1.0)   # looking down z
+    >>> tree = split((4, 4, 4), 2, shape="shafts")          # lower and upper halves in y
+    >>> tiles = screen_tiles(8, 8, 2)                       # left and right halves
+    >>> msgs, local = object_fragments(tree, [0, 1], tiles, view, (-1, -1, -1),
+    ...                                (0.5, 0.5, 0.5), bytes_per_pixel=1)
+    >>> local.tolist(), msgs.sent_per_node(2).tolist()     # half of each goes across
+    ([32.0, 32.0], [16.0, 16.0])
     """
     nodes = max(int(np.max(owners)) + 1, tiles.nodes)
     src, dst, size, local = [], [], [], []
@@ -138,7 +157,14 @@ def object_fragments(tree, owners, tiles, view, origin, spacing, *, bytes_per_pi
 
 def swap_slots(tree):
     """Binary swap's slots: the subtrees at depth ``floor(log2 P)`` of the k-d tree, each one
-    brick or two (a pair folded together before the swap), left to right."""
+    brick or two (a pair folded together before the swap), left to right.
+
+    Examples
+    --------
+    >>> from vrlib.parallel.decompose import split
+    >>> swap_slots(split((8, 8, 8), 3))           # brick 0 alone, bricks 1 and 2 folded
+    [0, (1, 4, 1, 2)]
+    """
     depth = int(math.floor(math.log2(len(tree))))
     slots = []
 
@@ -164,6 +190,16 @@ def binary_swap(tree, view, origin, spacing, *, bytes_per_pixel=4, bounded=True)
     With ``bounded`` a node sends only the part of the half inside the bounding rectangle of
     what its group has rendered; otherwise the whole half (the classic count, ``W^2 (1 - 1/P)``
     per node).
+
+    Examples
+    --------
+    >>> from vrlib import View
+    >>> from vrlib.parallel.decompose import split
+    >>> view = View.orbit(size=16)
+    >>> m = binary_swap(split((8, 8, 8), 4), view, (-1, -1, -1), (0.25, 0.25, 0.25),
+    ...                 bytes_per_pixel=1, bounded=False)
+    >>> m.sent_per_node(4).tolist()               # 16^2 x (1 - 1/4) each
+    [192.0, 192.0, 192.0, 192.0]
     """
     slots = swap_slots(tree)
     full = (0, view.height, 0, view.width)
@@ -207,7 +243,14 @@ def binary_swap(tree, view, origin, spacing, *, bytes_per_pixel=4, bounded=True)
 
 def gather(tiles_or_regions, nodes, *, root=0, bytes_per_pixel=4):
     """Every node's finished pixels to ``root`` (the display): ``tiles_or_regions`` is a
-    :class:`~vrlib.parallel.decompose.ScreenTiles` or a list of ``(node, rect)``."""
+    :class:`~vrlib.parallel.decompose.ScreenTiles` or a list of ``(node, rect)``.
+
+    Examples
+    --------
+    >>> from vrlib.parallel.decompose import screen_tiles
+    >>> gather(screen_tiles(8, 8, 4), 4, bytes_per_pixel=1).sent_per_node(4).tolist()
+    [0.0, 16.0, 16.0, 16.0]
+    """
     if hasattr(tiles_or_regions, "owner"):
         t = tiles_or_regions
         h = np.diff(t.rows)[:, None] * np.diff(t.cols)[None, :]
@@ -250,6 +293,15 @@ def _reach_pixels(view, depth, reach):
     return reach * view.distance / (view.pixel_size * np.maximum(depth, 1e-12))
 
 
+def _tile_range(bounds, x, rho):
+    """First and last tile (by ``bounds``) with a pixel centre within ``rho`` of ``x``; the
+    first exceeds the last when there is none."""
+    first = np.maximum(np.searchsorted(bounds, x - rho + 0.5, side="left") - 1, 0)
+    last = np.minimum(np.searchsorted(bounds, x + rho - 0.5, side="right") - 1,
+                      len(bounds) - 2)
+    return first, last
+
+
 def image_static(tree, owners, tiles, view, sample_shape, origin, spacing, *, radius=1.0,
                  bytes_per_voxel=1):
     """Image partition, data fixed in bricks: each tile owner receives every voxel its rays
@@ -258,6 +310,17 @@ def image_static(tree, owners, tiles, view, sample_shape, origin, spacing, *, ra
 
     Voxels are counted by projecting them; volumes of more than :data:`MAX_PROJECTED` samples
     are counted on a regular sub-lattice, each sample standing for ``stride^3``.
+
+    Examples
+    --------
+    >>> from vrlib import View
+    >>> from vrlib.parallel.decompose import screen_tiles, split
+    >>> view = View([0, 0, -1], up=[0, 1, 0], size=8, radius=1.0)
+    >>> tree = split((4, 4, 4), 2, shape="shafts")          # lower and upper halves in y
+    >>> msgs = image_static(tree, [0, 1], screen_tiles(8, 8, 2), view, (5, 5, 5),
+    ...                     (-1, -1, -1), (0.5, 0.5, 0.5), radius=0.1)
+    >>> msgs.sent_per_node(2).tolist()      # voxels each brick sends the other's tile
+    [5.0, 10.0]
     """
     stride = _sub_lattice(sample_shape)
     reach = radius * float(np.linalg.norm(spacing))
@@ -269,19 +332,11 @@ def image_static(tree, owners, tiles, view, sample_shape, origin, spacing, *, ra
             continue
         p = _project_samples(view, axes, origin, spacing)
         rho = _reach_pixels(view, p[:, 2], reach)
-        # Tiles whose pixel centres come within the reach: tile rows i with
-        # rows[i] + 0.5 <= r + rho and rows[i + 1] - 0.5 >= r - rho.
-        i0 = np.clip(np.searchsorted(tiles.rows, p[:, 0] - rho + 0.5, side="right") - 1,
-                     0, len(tiles.rows) - 2)
-        i1 = np.clip(np.searchsorted(tiles.rows, p[:, 0] + rho - 0.5, side="right") - 1,
-                     0, len(tiles.rows) - 2)
-        j0 = np.clip(np.searchsorted(tiles.cols, p[:, 1] - rho + 0.5, side="right") - 1,
-                     0, len(tiles.cols) - 2)
-        j1 = np.clip(np.searchsorted(tiles.cols, p[:, 1] + rho - 0.5, side="right") - 1,
-                     0, len(tiles.cols) - 2)
-        seen = p[:, 0] + rho >= 0.5
-        seen &= p[:, 0] - rho <= view.height - 0.5
-        seen &= (p[:, 1] + rho >= 0.5) & (p[:, 1] - rho <= view.width - 0.5)
+        # Tiles with a pixel centre within the reach: first tile i whose last centre
+        # rows[i + 1] - 0.5 >= r - rho, last tile whose first centre rows[i] + 0.5 <= r + rho.
+        i0, i1 = _tile_range(tiles.rows, p[:, 0], rho)
+        j0, j1 = _tile_range(tiles.cols, p[:, 1], rho)
+        seen = (i0 <= i1) & (j0 <= j1)
         voxel = np.arange(p.shape[0])
         keys = []
         for di in range(int((i1 - i0).max(initial=0)) + 1):
@@ -300,9 +355,19 @@ def image_static(tree, owners, tiles, view, sample_shape, origin, spacing, *, ra
 
 def image_dynamic(tiles, before, after, sample_shape, origin, spacing, *, bytes_per_voxel=1):
     """Image partition, data migrating with the view: each voxel lives on the owner of the
-    tile its centre projects into, and moves when the view changes from ``before`` to
-    ``after``. (Filter borders are left out: the voxels near a tile's edge that both nodes
-    need.)"""
+    tile its centre projects into (off-screen voxels: the nearest edge tile), and moves when
+    the view changes from ``before`` to ``after``. (Filter borders are left out: the voxels
+    near a tile's edge that both nodes need.)
+
+    Examples
+    --------
+    >>> from vrlib import View
+    >>> from vrlib.parallel.decompose import screen_tiles
+    >>> a, b = View.orbit(azimuth=0, size=8), View.orbit(azimuth=180, size=8)
+    >>> image_dynamic(screen_tiles(8, 8, 2), a, b, (5, 5, 5), (-1, -1, -1),
+    ...               (0.5, 0.5, 0.5)).total       # a half turn swaps left and right
+    105.0
+    """
     stride = _sub_lattice(sample_shape)
     nodes = tiles.nodes
     src, dst, size = [], [], []
