@@ -168,5 +168,7 @@ def test_bad_arguments_name_the_parameter(tmp_path):
     with pytest.raises(ValueError, match="cannot split"):
         mpi.render_object(comm, field, view, shape=2, balance="interleaved",
                           compositing="direct-send", bricks_per_rank=8)
+    with pytest.raises(ValueError, match="root must be a rank of the communicator, 0..0"):
+        mpi.render_object(comm, field, view, shape=9, root=1)
     with pytest.raises(TypeError, match="view must be a vrlib.View"):
         mpi.render_image(comm, field, "front", shape=9)

@@ -324,9 +324,9 @@ def _direct_send(comm, images, keys, tiles, sent):
     return mine, tile
 
 
-def _exchange(comm, partner, rgba, rect_out, rect_in, sent):
-    """Send the pixels ``rect_out`` of ``rgba`` to ``partner`` and receive its pixels (the
-    rectangle it names) for ``rect_in``; returns (rect, pixels) received."""
+def _exchange(comm, partner, rgba, rect_out, sent):
+    """Send the pixels ``rect_out`` of ``rgba`` to ``partner`` and receive the pixels it
+    sends (the rectangle it names first); returns (rect, pixels) received."""
     theirs = comm.sendrecv(rect_out, dest=partner, source=partner)
     sent["composite"] += HEADER
     buf = np.empty((max(theirs[1] - theirs[0], 0), max(theirs[3] - theirs[2], 0), 4))
@@ -356,10 +356,10 @@ def _binary_swap(comm, tree, rgba, order, sent):
         if isinstance(slot, tuple):
             first, second = slot[2], slot[3]
             if rank == second:  # fold: hand everything to the sibling and stop
-                _exchange(comm, first, rgba, _content(rgba), (0, 0, 0, 0), sent)
+                _exchange(comm, first, rgba, _content(rgba), sent)
                 return (0, 0, 0, 0), rgba
             if rank == first:
-                theirs, buf = _exchange(comm, second, rgba, (0, 0, 0, 0), None, sent)
+                theirs, buf = _exchange(comm, second, rgba, (0, 0, 0, 0), sent)
                 _merge(rgba, theirs, buf, position[first] < position[second])
             leaders.append(first)
         else:
@@ -377,7 +377,7 @@ def _binary_swap(comm, tree, rgba, order, sent):
             mid = (c0 + c1) // 2
             halves = ((r0, r1, c0, mid), (r0, r1, mid, c1))
         keep, give = halves if s < partner_slot else halves[::-1]
-        theirs, buf = _exchange(comm, partner, rgba, _content(rgba, give), keep, sent)
+        theirs, buf = _exchange(comm, partner, rgba, _content(rgba, give), sent)
         # The group whose bricks come first in the visibility order is in front.
         group = 1 << (r + 1)
         mine_front = min(position[b] for b in _group(tree, slots, s, group)) < \
@@ -415,7 +415,14 @@ def _gather(comm, rect, pixels, shape, root, sent):
 # ---------------------------------------------------------------- the renderers
 
 
-def _check(comm, view, filter, transfer, step, compositing=None, balance=None,
+def _root(root, size):
+    root = _validate.positive_int("root", root, minimum=0)
+    if root >= size:
+        raise ValueError(f"root must be a rank of the communicator, 0..{size - 1}, got {root}")
+    return root
+
+
+def _check(view, filter, transfer, step, compositing=None, balance=None,
            bricks_per_rank=1):
     if not isinstance(view, View):
         raise TypeError(f"view must be a vrlib.View, got {type(view).__name__}")
@@ -555,9 +562,9 @@ def render_object(comm, source, view, *, shape=None, extent=None, filter="trilin
     size, rank = comm.Get_size(), comm.Get_rank()
     sent = {"balance": 0, "voxels": 0, "composite": 0, "gather": 0}
     with _Stage(comm, "checking the arguments"):
-        filt, transfer, step = _check(comm, view, filter, transfer, step, compositing,
+        filt, transfer, step = _check(view, filter, transfer, step, compositing,
                                       balance, bricks_per_rank)
-        root = _validate.finite_number("root", root, low=0, high=size - 1)
+        root = _root(root, size)
         lattice, read = _source(source, shape, extent)
         parts = size * bricks_per_rank if balance == "interleaved" else size
         tree = split(lattice.cells, parts)
@@ -664,8 +671,8 @@ def render_image(comm, source, view, *, shape=None, extent=None, filter="triline
     size, rank = comm.Get_size(), comm.Get_rank()
     sent = {"balance": 0, "voxels": 0, "composite": 0, "gather": 0}
     with _Stage(comm, "checking the arguments"):
-        filt, transfer, step = _check(comm, view, filter, transfer, step)
-        root = _validate.finite_number("root", root, low=0, high=size - 1)
+        filt, transfer, step = _check(view, filter, transfer, step)
+        root = _root(root, size)
         lattice, read = _source(source, shape, extent)
         tree = split(lattice.cells, size)
         tiles = screen_tiles(view.height, view.width, size)
