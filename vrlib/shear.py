@@ -27,6 +27,7 @@ import time
 
 import numpy as np
 
+from vrlib import _validate
 from vrlib._kernels import shear as _kernel
 from vrlib.image import Image, RenderStats
 from vrlib.raycast import reconstructed_range, taps_per_axis
@@ -165,7 +166,11 @@ def _run_pass(src, out, c0, c1, c2, offset, lo, hi, filt, ntaps):
     return int(counts.sum()), first, last
 
 
-def _passes(volume, view, plan, filt, ntaps, count):
+#: Storage types of the shear methods' intermediate volumes.
+INTERMEDIATES = {"float32": np.float32, "float64": np.float64}
+
+
+def _passes(volume, view, plan, filt, ntaps, count, dtype):
     """Passes 1 and 2; returns ``V2[w, Y, X]`` and the computed output ranges of pass 2.
 
     Each pass computes only outputs the volume reaches: a line of pass 2 holds data where pass 1
@@ -174,12 +179,12 @@ def _passes(volume, view, plan, filt, ntaps, count):
     u, v, w = plan.order
     data = np.transpose(volume.data, (2 - w, 2 - v, 2 - u))  # [w, v, u], a view
     nw, nv, nu = data.shape
-    v1 = np.zeros((nw, nv, view.width), np.float32)
+    v1 = np.zeros((nw, nv, view.width), dtype)
     count["pass1"], first1, last1 = _run_pass(
         data, v1, plan.a, plan.b, plan.c, plan.t0, np.zeros((nw, nv), np.int64),
         np.full((nw, nv), nu - 1, np.int64), filt, ntaps)
     lo, hi = _filled(first1, last1, view.width)  # pass 2 lines (w, X) run along v
-    v2 = np.zeros((nw, view.height, view.width), np.float32)
+    v2 = np.zeros((nw, view.height, view.width), dtype)
     count["pass2"], first2, last2 = _run_pass(
         v1.transpose(0, 2, 1), v2.transpose(0, 2, 1), plan.e, plan.d, plan.f, plan.t1, lo, hi,
         filt, ntaps)
@@ -195,16 +200,23 @@ def _stats(volume, taps, count, composited, seconds, largest):
                        bytes=int(largest), seconds=seconds, voxels=resampled, passes=count)
 
 
+def _intermediate(intermediate):
+    return INTERMEDIATES[_validate.choice("intermediate", intermediate, tuple(INTERMEDIATES))]
+
+
 def render_shear3(volume, view, *, filt, transfer, step, early_termination,
-                  empty_space_skipping):
-    """Three-pass shear rendering (arguments validated by :func:`vrlib.render`)."""
+                  empty_space_skipping, intermediate="float32"):
+    """Three-pass shear rendering (arguments validated by :func:`vrlib.render`).
+    ``intermediate`` stores the resampled volumes as float32 (half the memory; the default)
+    or float64 (chapter ch08 measures the difference)."""
     ntaps = _check(view, filt, _AFFINE_ONLY)
+    dtype = _intermediate(intermediate)
     start = time.perf_counter()
     ds = step * float(volume.spacing.min())
     plan = plan_shear(volume, view, ds)
     count = {}
-    v2, first2, last2 = _passes(volume, view, plan, filt, ntaps, count)
-    v3 = np.zeros((plan.depth_samples, view.height, view.width), np.float32)
+    v2, first2, last2 = _passes(volume, view, plan, filt, ntaps, count, dtype)
+    v3 = np.zeros((plan.depth_samples, view.height, view.width), dtype)
     # Pass 3 lines (Y, X) run along w: first2/last2 are indexed [w, X] over Y.
     lo, hi = _filled(first2.transpose(1, 0), last2.transpose(1, 0), view.height)  # [X, Y]
     count["pass3"], _, _ = _run_pass(
@@ -224,15 +236,17 @@ def render_shear3(volume, view, *, filt, transfer, step, early_termination,
 
 
 def render_shear2(volume, view, *, filt, transfer, step, early_termination,
-                  empty_space_skipping):
+                  empty_space_skipping, intermediate="float32"):
     """Two-pass shear rendering (arguments validated by :func:`vrlib.render`). ``step`` sets
-    the lattice of the image plane only: samples along a ray are the volume's slices."""
+    the lattice of the image plane only: samples along a ray are the volume's slices.
+    ``intermediate`` as for :func:`render_shear3`."""
     ntaps = _check(view, filt, _AFFINE_ONLY)
+    dtype = _intermediate(intermediate)
     start = time.perf_counter()
     ds = step * float(volume.spacing.min())
     plan = plan_shear(volume, view, ds)
     count = {}
-    v2, _, _ = _passes(volume, view, plan, filt, ntaps, count)
+    v2, _, _ = _passes(volume, view, plan, filt, ntaps, count, dtype)
     length = abs(plan.i) * ds  # world distance between slices along a ray
     tables = transfer.segment_table(length, *reconstructed_range(volume, filt))
     m = plan.matrix
@@ -359,11 +373,10 @@ def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
         (lossy, as VolPack's threshold). Skipping is on with ``empty_space_skipping`` and for
         filters without negative lobes.
     """
-    from vrlib._validate import finite_number
     from vrlib.skipping import lattice_sums, transparent_runs
     from vrlib.splat import major_axis
 
-    min_opacity = finite_number("min_opacity", min_opacity, low=0.0, high=1.0, high_open=True)
+    min_opacity = _validate.finite_number("min_opacity", min_opacity, low=0.0, high=1.0, high_open=True)
     ntaps = _check(view, filt)
     start = time.perf_counter()
     axis, ascending = major_axis(volume, view)
