@@ -80,8 +80,8 @@ def render(volume, view, *, method="raycast", filter="trilinear", transfer=None,
     **options
         Options of the chosen method (:func:`method_options` lists them): for ``"splat"``,
         ``mode`` ("sheet" or "direct") and ``footprint_resolution``; for ``"shearwarp"``,
-        ``min_opacity``; for ``"shear3"`` and ``"shear2"``, ``intermediate`` ("float32" or
-        "float64" storage of the resampled volumes).
+        ``min_opacity``; for ``"shear3"`` and ``"shear2"``, ``intermediate`` ("auto", "float32"
+        or "float64" storage of the resampled volumes).
 
     Returns
     -------
