@@ -35,6 +35,8 @@ html_theme_options = {"description": "Volume reconstruction and parallel renderi
 def _load_results():
     results = {}
     for path in sorted((ROOT / "build" / "results").glob("*/*.json")):
+        if path.name.startswith("."):  # a temporary file left by an interrupted write
+            continue
         results.setdefault(path.parent.name, {})[path.stem] = json.loads(path.read_text())
     return results
 

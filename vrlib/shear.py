@@ -393,7 +393,8 @@ def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
     from vrlib.skipping import lattice_sums, transparent_runs
     from vrlib.splat import major_axis
 
-    min_opacity = _validate.finite_number("min_opacity", min_opacity, low=0.0, high=1.0, high_open=True)
+    min_opacity = _validate.finite_number("min_opacity", min_opacity, low=0.0, high=1.0,
+                                          high_open=True)
     ntaps = _check(view, filt)
     start = time.perf_counter()
     axis, ascending = major_axis(volume, view)
