@@ -131,3 +131,24 @@ def test_repr():
     assert repr(Volume(np.zeros((2, 3, 4)))) == (
         "Volume(shape=(2, 3, 4), dtype=float64, extent=[[-1, 1], [-1, 1], [-1, 1]])"
     )
+
+
+def test_pyvista_round_trip_keeps_samples_and_extent():
+    """Volume -> pyvista.ImageData -> Volume is exact, for an anisotropic, offset volume."""
+    pytest.importorskip("pyvista")
+    data = np.random.default_rng(4).uniform(size=(3, 5, 7))
+    vol = Volume(data, extent=[[-2.0, 1.0], [0.5, 1.5], [10.0, 10.2]])
+    back = Volume.from_pyvista(vol.to_pyvista("density"), scalars="density")
+    np.testing.assert_array_equal(back.data, vol.data)
+    np.testing.assert_allclose(back.extent, vol.extent, rtol=1e-15)
+
+
+def test_from_pyvista_refuses_what_it_cannot_read():
+    pv = pytest.importorskip("pyvista")
+    with pytest.raises(TypeError, match="grid must be a pyvista.ImageData"):
+        Volume.from_pyvista(np.zeros((3, 3, 3)))
+    grid = pv.ImageData(dimensions=(3, 3, 3))
+    grid.point_data["a"] = np.zeros(27)
+    grid.point_data["b"] = np.ones(27)
+    with pytest.raises(ValueError, match="scalars 'c' is not a point array"):
+        Volume.from_pyvista(grid, scalars="c")

@@ -266,6 +266,74 @@ class Volume:
             self._derived[key] = copy
         return self._derived[key]
 
+    @classmethod
+    def from_pyvista(cls, grid, scalars=None):
+        """A volume from a pyvista ``ImageData`` (VTK image data): its point scalars, origin
+        and spacing.
+
+        Parameters
+        ----------
+        grid : pyvista.ImageData
+            A regular grid with at least 2 points along each axis (axis-aligned: a
+            ``direction_matrix`` other than the identity is refused).
+        scalars : str, optional
+            Name of the point array; default the active scalars.
+
+        Examples
+        --------
+        >>> import pyvista as pv
+        >>> grid = pv.ImageData(dimensions=(4, 3, 2), spacing=(0.5, 1.0, 2.0))
+        >>> grid.point_data["density"] = np.arange(24.0)
+        >>> vol = Volume.from_pyvista(grid)
+        >>> vol.shape, vol.extent.tolist(), float(vol.data[1, 0, 0])
+        ((2, 3, 4), [[0.0, 1.5], [0.0, 2.0], [0.0, 2.0]], 12.0)
+        """
+        import pyvista as pv
+
+        if not isinstance(grid, pv.ImageData):
+            raise TypeError(f"grid must be a pyvista.ImageData, got {type(grid).__name__}")
+        direction = getattr(grid, "direction_matrix", None)
+        if direction is not None and not np.allclose(np.asarray(direction), np.eye(3)):
+            raise ValueError("grid must be axis-aligned (identity direction_matrix)")
+        if scalars is None:
+            scalars = grid.active_scalars_name
+            if scalars is None:
+                if len(grid.point_data.keys()) != 1:
+                    raise ValueError("grid has no active point scalars: name one with "
+                                     f"scalars=; point arrays: {list(grid.point_data.keys())}")
+                scalars = grid.point_data.keys()[0]
+        if scalars not in grid.point_data:
+            raise ValueError(f"scalars {scalars!r} is not a point array of the grid; point "
+                             f"arrays: {list(grid.point_data.keys())}")
+        nx, ny, nz = grid.dimensions
+        values = np.asarray(grid.point_data[scalars])
+        if values.ndim != 1:
+            raise ValueError(f"scalars {scalars!r} must hold one value per point, got shape "
+                             f"{values.shape}")
+        origin = np.asarray(grid.origin, float)
+        spacing = np.asarray(grid.spacing, float)
+        extent = np.stack([origin, origin + (np.array([nx, ny, nz]) - 1) * spacing], axis=1)
+        return cls(values.reshape(nz, ny, nx), extent=extent)
+
+    def to_pyvista(self, name="values"):
+        """The volume as a pyvista ``ImageData`` with its samples as point scalars ``name``.
+
+        Examples
+        --------
+        >>> vol = Volume(np.arange(24.0).reshape(2, 3, 4))
+        >>> grid = vol.to_pyvista()
+        >>> grid.dimensions, Volume.from_pyvista(grid).extent.tolist() == vol.extent.tolist()
+        ((4, 3, 2), True)
+        """
+        import pyvista as pv
+
+        nz, ny, nx = self.shape
+        grid = pv.ImageData(dimensions=(nx, ny, nz), spacing=tuple(self.spacing),
+                            origin=tuple(self.origin))
+        grid.point_data[name] = np.ascontiguousarray(self._data).ravel()
+        grid.set_active_scalars(name)
+        return grid
+
     def __repr__(self):
         ext = ", ".join(f"[{lo:g}, {hi:g}]" for lo, hi in self._extent)
         return f"Volume(shape={self.shape}, dtype={self.dtype}, extent=[{ext}])"

@@ -63,9 +63,10 @@ def convergence_figure():
     left.set_ylabel("largest error")
     left.set_title(f"Ray casting against the closed form, {data['volume']}$^3$", fontsize=10)
     left.legend(fontsize=8)
-    for method, entry in data["resolution"].items():
+    for (method, entry), style in zip(data["resolution"].items(),
+                                      ("-o", "--s", ":^", "-.v", "-D"), strict=False):
         rows = entry["rows"]
-        right.loglog([r["N"] for r in rows], [r["rmse"] for r in rows], "-o", ms=4,
+        right.loglog([r["N"] for r in rows], [r["rmse"] for r in rows], style, ms=4,
                      label=f"{method} (order {entry['order']:.2f})")
     right.set_xlabel("samples per axis N")
     right.set_ylabel("rmse")
