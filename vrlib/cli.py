@@ -141,6 +141,8 @@ def _add_scene(parser):
 def cmd_render(args):
     import vrlib
 
+    if Path(args.output).suffix.lower() not in (".png", ".npy"):
+        raise UsageError(f"output must end in .png or .npy, got {args.output!r}")
     volume, _ = load_volume(args.volume, shape=args.shape, dtype=args.dtype)
     view = make_view(args, volume)
     start = time.perf_counter()

@@ -1,0 +1,112 @@
+"""The command line, run as a user runs it: the ``vrlib`` console script and
+``python -m vrlib``."""
+
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+SCRIPT = Path(sys.executable).parent / "vrlib"
+
+
+def run(*args, module=False, cwd=None):
+    command = [sys.executable, "-m", "vrlib", *args] if module else [str(SCRIPT), *args]
+    env = dict(os.environ)
+    if "NUMBA_CACHE_DIR" in env:  # the JIT cache stays where it is, whatever the cwd
+        env["NUMBA_CACHE_DIR"] = str(Path(env["NUMBA_CACHE_DIR"]).resolve())
+    return subprocess.run(command, capture_output=True, text=True, timeout=300, cwd=cwd,
+                          env=env, check=False)
+
+
+def test_render_writes_the_image_both_ways(tmp_path):
+    for module in (False, True):
+        out = tmp_path / f"ml{int(module)}.png"
+        done = run("render", "marschner-lobb:17", "--size", "24", "-o", str(out),
+                   module=module)
+        assert done.returncode == 0, done.stderr
+        assert out.read_bytes().startswith(b"\x89PNG")
+
+
+def test_render_npy_matches_the_python_api(tmp_path):
+    import data_gen
+    import vrlib
+
+    out = tmp_path / "blob.npy"
+    done = run("render", "gaussian-blob:20:sigma=0.3", "--method", "splat", "--filter",
+               "bspline", "--size", "16", "--azimuth", "10", "--elevation", "5", "-o",
+               str(out))
+    assert done.returncode == 0, done.stderr
+    vol = data_gen.make_field("gaussian-blob", sigma=0.3).sample(20)
+    view = vrlib.View.orbit(azimuth=10, elevation=5, size=16, radius=vol.bounding_radius,
+                            center=vol.center)
+    expected = vrlib.render(vol, view, method="splat", filter="bspline")
+    np.testing.assert_array_equal(np.load(out), expected.rgba)
+
+
+def test_render_reads_files(tmp_path):
+    data = np.zeros((8, 8, 8), np.uint8)
+    data[2:6, 2:6, 2:6] = 200
+    np.save(tmp_path / "cube.npy", data)
+    data.tofile(tmp_path / "cube.raw")
+    for name, extra in (("cube.npy", []), ("cube.raw", ["--shape", "8,8,8", "--dtype",
+                                                        "uint8"])):
+        done = run("render", str(tmp_path / name), *extra, "--transfer", "ramp:0.5:4",
+                   "--size", "16", "-o", str(tmp_path / f"{name}.png"))
+        assert done.returncode == 0, done.stderr
+
+
+@pytest.mark.parametrize("args, message", [
+    (["render", "nothing", "-o", "x.png"], "unknown volume 'nothing'"),
+    (["render", "marschner-lobb:17", "--method", "foo", "-o", "x.png"], "unknown method"),
+    (["render", "marschner-lobb:17", "--filter", "lanczos", "-o", "x.png"],
+     "unknown filter"),
+    (["render", "marschner-lobb:x", "-o", "x.png"], "samples per axis must be an integer"),
+    (["render", "marschner-lobb:17", "-o", "x.jpg"], "output must end in .png or .npy"),
+    (["render", "marschner-lobb:17", "--size", "0", "-o", "x.png"], "size"),
+    (["render", "marschner-lobb:17", "--transfer", "fog:1", "-o", "x.png"], "transfer"),
+    (["render", "gaussian-blob:17:sigma=-1", "-o", "x.png"], "sigma"),
+    (["render", "missing.npy", "-o", "x.png"], "volume file not found"),
+    (["render", "missing.raw", "-o", "x.png"], "volume file not found"),
+    (["render", "marschner-lobb:17", "--projection", "perspective", "--method", "shear3",
+      "-o", "x.png"], "orthographic only"),
+])
+def test_bad_input_exits_2_with_one_line(tmp_path, args, message):
+    done = run(*args, cwd=tmp_path)
+    assert done.returncode == 2
+    lines = done.stderr.strip().splitlines()
+    assert len(lines) == 1 and message in lines[0], done.stderr
+    assert not any(tmp_path.iterdir()), "nothing may be written on bad input"
+
+
+def test_argparse_errors_exit_2():
+    done = run("render", "marschner-lobb:17")  # no -o
+    assert done.returncode == 2 and "-o/--output" in done.stderr
+
+
+def test_help_shows_examples():
+    for args in (["--help"], ["render", "--help"]):
+        done = run(*args)
+        assert done.returncode == 0
+        assert "vrlib render marschner-lobb:41 -o ml.png" in done.stdout
+
+
+def test_compare_prints_a_table_and_saves_a_figure(tmp_path):
+    out = tmp_path / "compare.png"
+    done = run("compare", "gaussian-blob:17:sigma=0.3", "--size", "24", "-o", str(out))
+    assert done.returncode == 0, done.stderr
+    for method in ("raycast", "splat", "shear3", "shear2", "shearwarp"):
+        assert method in done.stdout
+    assert "reference renderer" in done.stdout
+    assert out.read_bytes().startswith(b"\x89PNG")
+
+
+def test_bench_and_info():
+    done = run("bench", "--samples", "12", "--size", "16", "--repeats", "1")
+    assert done.returncode == 0, done.stderr
+    assert "rmse" in done.stdout and done.stdout.count("\n") >= 11
+    done = run("info")
+    assert done.returncode == 0
+    assert "numba" in done.stdout and "MPICH" in done.stdout
