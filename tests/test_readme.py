@@ -1,16 +1,71 @@
-"""The README's Python example runs as written."""
+"""The README's examples run as written, and its pictures are what their commands make."""
 
+import os
 import re
+import shlex
+import subprocess
+import sys
 from pathlib import Path
 
-README = Path(__file__).resolve().parent.parent / "README.md"
+import numpy as np
+
+ROOT = Path(__file__).resolve().parent.parent
+README = ROOT / "README.md"
+VRLIB = Path(sys.executable).parent / "vrlib"
+#: The commands that made the README's pictures.
+PICTURES = {
+    "docs/images/mni152.png": "vrlib render mni152 --size 320 --zoom 1.7 --transfer "
+                              "ramp:0.3:300 --shade --azimuth 120 --elevation 15",
+    "docs/images/marschner-lobb.png": "vrlib render marschner-lobb:96 --size 320 --transfer "
+                                      "ramp:0.5:2000 --shade --elevation 30",
+}
+
+
+def blocks(language):
+    return re.findall(rf"```{language}\n(.*?)```", README.read_text(), flags=re.S)
+
+
+def shell(command, cwd):
+    args = shlex.split(command)
+    assert args[0] == "vrlib"
+    env = dict(os.environ)
+    if "NUMBA_CACHE_DIR" in env:
+        env["NUMBA_CACHE_DIR"] = str(Path(env["NUMBA_CACHE_DIR"]).resolve())
+    return subprocess.run([str(VRLIB), *args[1:]], cwd=cwd, env=env, capture_output=True,
+                          text=True, timeout=300, check=False)
+
+
+def test_readme_short_example_and_its_cli_twin_agree(tmp_path, monkeypatch):
+    """The three-line Python example and the one-line CLI example make the same picture."""
+    monkeypatch.chdir(tmp_path)
+    exec(compile(blocks("python")[0], "README.md", "exec"), {})
+    python_png = (tmp_path / "ml.png").read_bytes()
+    (tmp_path / "ml.png").unlink()
+    line = next(b for b in blocks("bash") if b.startswith("vrlib render")).strip()
+    done = shell(line, tmp_path)
+    assert done.returncode == 0, done.stderr
+    assert (tmp_path / "ml.png").read_bytes() == python_png
 
 
 def test_readme_python_example_runs(tmp_path, monkeypatch, capsys):
-    blocks = re.findall(r"```python\n(.*?)```", README.read_text(), flags=re.S)
-    assert blocks, "README.md has no python example"
     monkeypatch.chdir(tmp_path)
-    exec(compile(blocks[0], "README.md", "exec"), {})
+    exec(compile(blocks("python")[1], "README.md", "exec"), {})
     printed = float(capsys.readouterr().out.strip().splitlines()[-1])
     assert printed < 1e-5  # the rmse the comment quotes (about 5e-6)
     assert (tmp_path / "blob.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_readme_pictures_are_what_their_commands_make(tmp_path):
+    import imageio.v3 as iio
+
+    text = README.read_text()
+    for picture, command in PICTURES.items():
+        assert picture in text
+        done = shell(f"{command} -o {tmp_path / 'out.png'}", tmp_path)
+        assert done.returncode == 0, done.stderr
+        made = iio.imread(tmp_path / "out.png").astype(int)
+        committed = iio.imread(ROOT / picture).astype(int)
+        assert made.shape == committed.shape
+        # Identical on this machine; a different CPU may round a few pixels differently.
+        assert np.abs(made - committed).max() <= 2
+        assert np.mean(made != committed) < 0.01

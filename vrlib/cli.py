@@ -16,7 +16,7 @@ import numpy as np
 EXAMPLES = """examples:
   vrlib render marschner-lobb:41 -o ml.png
   vrlib render gaussian-blob:64:sigma=0.3 --method splat --filter catmull-rom -o blob.png
-  vrlib render head.nii.gz --transfer ramp:0.3:4 --azimuth 90 --size 512 -o head.png
+  vrlib render mni152 --transfer ramp:0.3:40 --shade --azimuth 90 --size 512 -o head.png
   vrlib render scan.raw --shape 64,64,64 --dtype uint8 -o scan.png
   vrlib compare marschner-lobb:41 --size 128 -o compare.png
   vrlib bench
@@ -76,10 +76,12 @@ def load_volume(spec, *, shape=None, dtype=None):
     return field.sample(samples), field
 
 
-def make_transfer(spec):
+def make_transfer(spec, shade=False):
     """``glow:K`` (default ``glow:1``) or ``ramp:THRESHOLD:SCALE`` (transparent below the
-    threshold, a fraction of the value range)."""
+    threshold, a fraction of the value range); ``shade`` adds Phong shading."""
     import vrlib
+
+    shading = vrlib.Phong() if shade else None
 
     kind, *args = spec.split(":")
     try:
@@ -87,7 +89,7 @@ def make_transfer(spec):
     except ValueError:
         raise UsageError(f"transfer numbers must be numbers, got {spec!r}") from None
     if kind == "glow" and len(numbers) <= 1:
-        return lambda volume: vrlib.Glow(numbers[0] if numbers else 1.0)
+        return lambda volume: vrlib.Glow(numbers[0] if numbers else 1.0, shading=shading)
     if kind == "ramp" and len(numbers) == 2:
         threshold, scale = numbers
         if not 0.0 <= threshold < 1.0:
@@ -98,7 +100,7 @@ def make_transfer(spec):
             hi = hi if hi > lo else lo + 1.0
             values = np.linspace(0.0, 1.0, 257)
             density = scale * np.clip((values - threshold) / (1.0 - threshold), 0.0, 1.0)
-            return vrlib.LookupTransfer(density, value_range=(lo, hi))
+            return vrlib.LookupTransfer(density, value_range=(lo, hi), shading=shading)
         return ramp
     raise UsageError(f"transfer must be glow[:K] or ramp:THRESHOLD:SCALE, got {spec!r}")
 
@@ -129,6 +131,7 @@ def _add_scene(parser):
                         help="reconstruction filter (default catmull-rom)")
     parser.add_argument("--transfer", default="glow:1",
                         help="glow[:K] or ramp:THRESHOLD:SCALE (default glow:1)")
+    parser.add_argument("--shade", action="store_true", help="Phong shading (gradients)")
     parser.add_argument("--azimuth", type=float, default=30.0)
     parser.add_argument("--elevation", type=float, default=20.0)
     parser.add_argument("--size", type=int, default=256, help="image size in pixels")
@@ -147,7 +150,7 @@ def cmd_render(args):
     view = make_view(args, volume)
     start = time.perf_counter()
     img = vrlib.render(volume, view, method=args.method, filter=args.filter,
-                       transfer=make_transfer(args.transfer)(volume), step=args.step)
+                       transfer=make_transfer(args.transfer, args.shade)(volume), step=args.step)
     seconds = time.perf_counter() - start
     img.save(args.output, bits=args.bits)
     print(f"{args.output}: {view.width}x{view.height} {args.method}/{args.filter} "
@@ -173,7 +176,7 @@ def cmd_compare(args):
 
     volume, field = load_volume(args.volume, shape=args.shape, dtype=args.dtype)
     view = make_view(args, volume)
-    transfer = make_transfer(args.transfer)(volume)
+    transfer = make_transfer(args.transfer, args.shade)(volume)
     if field is not None:
         reference = vrlib.render_reference(field, view, transfer=transfer)
         label = "reference renderer (exact field)"
