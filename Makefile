@@ -33,6 +33,7 @@ stamp = $(patsubst chapters/%.py,build/stamps/%.done,$(1))
 RESULTS := $(call stamp,$(RUNS) $(PLOTS))
 DOCS := $(shell find docs -type f -not -path 'docs/_build/*')
 REPORT := build/report/html/index.html
+VERDICTS := build/results/claims/verdicts.json
 
 .PHONY: all venv results report test test-all bench lint clean distclean
 
@@ -45,7 +46,15 @@ $(INSTALLED): pyproject.toml constraints.txt
 	$(PY) -m pip install --quiet --disable-pip-version-check -c constraints.txt -e '.[all]'
 	@touch $@
 
-results: $(RESULTS)
+results: $(RESULTS) $(VERDICTS)
+
+# The report's verdict on each thesis claim comes from its claim tests (tests/claims): each
+# test is marked as supporting, refuting or going beyond a claim. A failing test is recorded,
+# not hidden: its claim's verdict changes.
+$(VERDICTS): $(wildcard tests/claims/*.py) $(LIBRARY) $(INSTALLED)
+	@mkdir -p $(@D)
+	VRLIB_VERDICTS=$@ $(PY) -m pytest -q tests/claims || echo "claim tests failed: see the verdicts"
+	@test -s $@
 
 # run_* scripts compute and write build/results/<chapter>/...; chapters/<chapter>/_*.py are
 # helpers shared by a chapter's scripts.
@@ -63,7 +72,7 @@ $(call stamp,$(PLOTS)): build/stamps/%.done: \
 report: $(REPORT)
 
 # Built into a fresh folder and swapped in whole: never a half-written report.
-$(REPORT): $(DOCS) $(RESULTS) $(LIBRARY) $(INSTALLED)
+$(REPORT): $(DOCS) $(RESULTS) $(VERDICTS) $(LIBRARY) $(INSTALLED)
 	@rm -rf build/report/html.tmp
 	$(PY) -m sphinx -W --keep-going -q -b html -d build/report/doctrees docs build/report/html.tmp
 	@rm -rf build/report/html && mv build/report/html.tmp build/report/html

@@ -26,6 +26,7 @@ def per_point(method, filt, *, m=2.0, n=32):
     return stats.operations / points(method, stats), points(method, stats)
 
 
+@pytest.mark.claim(2, "supports")
 @pytest.mark.parametrize("filt", ["pyramid", "gaussian", "catmull-rom", "bspline"])
 def test_splatting_does_fewer_operations_per_point_than_ray_casting(filt):
     splat, _ = per_point("splat", filt)
@@ -33,6 +34,7 @@ def test_splatting_does_fewer_operations_per_point_than_ray_casting(filt):
     assert splat < ray
 
 
+@pytest.mark.claim(2, "refutes")
 @pytest.mark.parametrize("filt", ["pyramid", "catmull-rom"])
 def test_splatting_reconstructs_more_points_per_frame(filt):
     """Why cheaper points do not make a cheaper frame: at two pixels per voxel a footprint

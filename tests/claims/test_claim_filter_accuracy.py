@@ -18,6 +18,7 @@ RATIOS = [0.5, 0.75, 1.0, 1.5, 2.0, 3.0]
 GAUSSIANS = [("gaussian", s, 2.0) for s in (0.5, 0.6, 0.7, 0.8)]
 
 
+@pytest.mark.claim(1, "supports")
 @pytest.mark.parametrize("dims", [1, 3])
 def test_catmull_rom_has_the_lowest_worst_case_error_at_every_feature_size(dims):
     for ratio in RATIOS:
@@ -26,6 +27,7 @@ def test_catmull_rom_has_the_lowest_worst_case_error_at_every_feature_size(dims)
             assert cubic < bounds.feature_error(other, ratio, dims=dims), (other, ratio)
 
 
+@pytest.mark.claim(1, "supports")
 def test_catmull_rom_has_the_lowest_fourier_bound():
     """The analytic bound ranks the filters the same way as the measured worst case."""
     for ratio in RATIOS:
@@ -34,6 +36,7 @@ def test_catmull_rom_has_the_lowest_fourier_bound():
             assert cubic < bounds.fourier_bound(other, ratio), (other, ratio)
 
 
+@pytest.mark.claim(1, "refutes")
 def test_the_claim_fails_for_the_cubic_b_spline():
     """The B-spline is a separable cubic too, and it is less accurate than the pyramid filter
     at every feature size: it blurs (its response at Nyquist is 0.16 against the tent's
@@ -43,6 +46,7 @@ def test_the_claim_fails_for_the_cubic_b_spline():
     assert np.all(errors[0] > errors[1])
 
 
+@pytest.mark.claim(1, "supports")
 def test_a_truncated_gaussian_has_an_error_floor_the_cubic_does_not():
     """At sigma/h = 6 the cubic's error is below 2e-4 while the Gaussian of s = 0.8 (R = 2)
     stays above 1% from its ripple."""
@@ -62,6 +66,7 @@ def _image_errors(field, n, scale, methods, size=48):
             for m in methods for f in ("catmull-rom", "pyramid", "gaussian", "bspline")}
 
 
+@pytest.mark.claim(1, "supports")
 @pytest.mark.parametrize("method", ["raycast", "shear3", "shear2", "shearwarp"])
 def test_catmull_rom_images_are_closest_to_the_reference(method):
     """Image part of claim 1 (chapter ch03): on Marschner-Lobb at 41^3 and on a blob of about
@@ -76,6 +81,7 @@ def test_catmull_rom_images_are_closest_to_the_reference(method):
             assert errors[method, "catmull-rom"] < errors[method, other], (field, other)
 
 
+@pytest.mark.claim(1, "supports")
 def test_splatting_ranks_the_filters_alike_on_fields_that_vanish_at_the_faces():
     """Splatting's kernels reach past the volume's faces (where the reference stops), which
     adds the same rim error for every filter on fields that do not vanish there; on a blob the

@@ -66,6 +66,7 @@ def loads():
     return out
 
 
+@pytest.mark.claim(3, "supports")
 def test_block_partitions_need_less_bandwidth_per_channel_as_the_machine_grows(loads):
     blocks = loads["blocks"]
     assert slope([f["bisection"] for f in blocks]) < -0.08  # derived -1/6
@@ -74,6 +75,7 @@ def test_block_partitions_need_less_bandwidth_per_channel_as_the_machine_grows(l
     assert blocks[-1]["max"] < blocks[0]["max"]
 
 
+@pytest.mark.claim(3, "supports")
 def test_blocks_communicate_less_than_shafts_and_slabs(loads):
     for i in range(2):
         assert loads["blocks"][i]["total"] < loads["shafts"][i]["total"] \
@@ -83,6 +85,7 @@ def test_blocks_communicate_less_than_shafts_and_slabs(loads):
     assert loads["blocks"][-1]["max"] < loads["shafts"][-1]["max"]
 
 
+@pytest.mark.claim(3, "refutes")
 def test_object_beats_the_static_image_partition_only_on_large_machines(loads):
     """The image partition's traffic grows with the volume (N^3 ~ P); the blocks' with
     P^(1/3). At 16 nodes the image partition sends less; at 1024, more."""

@@ -28,6 +28,7 @@ PROGRAM = Path(__file__).parent.parent / "mpi_programs" / "render.py"
 MPIEXEC = Path(sys.executable).parent / "mpiexec"
 
 
+@pytest.mark.claim(4, "supports")
 def test_every_class_of_the_taxonomy_can_be_built():
     """Each class maps to a decomposition: object shapes to k-d trees of bricks (interleaved:
     k bricks per node dealt round-robin), image classes to screen tiles."""
@@ -48,6 +49,7 @@ def test_every_class_of_the_taxonomy_can_be_built():
             assert tiles.nodes == nodes
 
 
+@pytest.mark.claim(4, "supports")
 def test_object_partition_costs_order_as_derived():
     """At 64 nodes: blocks < shafts < slabs per frame, and interleaving 8 blocks per node
     multiplies the blocks' traffic by about 8^(1/3) = 2 (within 15%)."""
@@ -75,6 +77,7 @@ def imbalance(work):
     return float(work.max() / work.mean())
 
 
+@pytest.mark.claim(5, "beyond")
 def test_work_sized_split_balances_a_sparse_scene_serially():
     """The serial twin of the work map: visible cells per brick, equal bricks against the
     work-sized split, on six random blobs (about 1% visible) for 8 ranks."""
@@ -98,6 +101,7 @@ def test_work_sized_split_balances_a_sparse_scene_serially():
     assert balanced < 1.3
 
 
+@pytest.mark.claim(5, "beyond")
 @pytest.mark.mpi
 def test_work_sized_split_balances_ray_samples_under_mpi():
     """Under mpiexec with 8 ranks on the sparse scene: max / mean ray samples per rank is
