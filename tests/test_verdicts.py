@@ -11,19 +11,19 @@ rules = importlib.util.module_from_spec(spec)
 spec.loader.exec_module(rules)
 
 
-def tests(*pairs):
+def outcomes_of(*pairs):
     return [{"role": role, "outcome": outcome} for role, outcome in pairs]
 
 
 @pytest.mark.parametrize("outcomes, expected", [
-    (tests(("supports", "passed"), ("supports", "passed")), "reproduced"),
-    (tests(("supports", "passed"), ("refutes", "passed")), "partly reproduced"),
-    (tests(("supports", "passed"), ("supports", "failed")), "partly reproduced"),
-    (tests(("supports", "failed"), ("refutes", "passed")), "not reproduced"),
-    (tests(("supports", "passed"), ("refutes", "failed")), "reproduced"),
-    (tests(("beyond", "passed"), ("beyond", "passed")), "beyond the thesis"),
-    (tests(("beyond", "failed")), "not reproduced"),
-    (tests(("supports", "passed"), ("supports", "skipped")), "reproduced"),
+    (outcomes_of(("supports", "passed"), ("supports", "passed")), "reproduced"),
+    (outcomes_of(("supports", "passed"), ("refutes", "passed")), "partly reproduced"),
+    (outcomes_of(("supports", "passed"), ("supports", "failed")), "partly reproduced"),
+    (outcomes_of(("supports", "failed"), ("refutes", "passed")), "not reproduced"),
+    (outcomes_of(("supports", "passed"), ("refutes", "failed")), "reproduced"),
+    (outcomes_of(("beyond", "passed"), ("beyond", "passed")), "beyond the thesis"),
+    (outcomes_of(("beyond", "failed")), "not reproduced"),
+    (outcomes_of(("supports", "passed"), ("supports", "skipped")), "reproduced"),
 ])
 def test_verdict_rule(outcomes, expected):
     assert rules.verdict(outcomes) == expected
