@@ -127,9 +127,12 @@ def plan_shear(volume, view, ds):
                      np.array([t0, ty, tz - z_first]))
 
 
-def _check(view, filt, refusal=None):
-    """Refuse filters wider than 4 voxels, and perspective views with ``refusal`` when one is
-    given; return the filter's taps per axis."""
+def _check(view, filt, refusal=None, transfer=None):
+    """Refuse filters wider than 4 voxels, shaded transfer functions, and perspective views
+    with ``refusal`` when one is given; return the filter's taps per axis."""
+    if transfer is not None and transfer.shading is not None:
+        raise ValueError("volume shearing does not shade (it resamples no gradients); use "
+                         "method='raycast' for shaded images")
     if refusal is not None and view.is_perspective:
         raise ValueError(refusal)
     ntaps = taps_per_axis(filt)
@@ -226,7 +229,7 @@ def render_shear3(volume, view, *, filt, transfer, step, early_termination,
     ``intermediate`` stores the resampled volumes as float32 (half the memory) or float64;
     ``"auto"`` takes float32 unless the volume's magnitudes need float64 (chapter ch08
     measures the difference: about 1e-8 in the image)."""
-    ntaps = _check(view, filt, _AFFINE_ONLY)
+    ntaps = _check(view, filt, _AFFINE_ONLY, transfer)
     dtype = _intermediate(intermediate, volume)
     start = time.perf_counter()
     ds = step * float(volume.spacing.min())
@@ -257,7 +260,7 @@ def render_shear2(volume, view, *, filt, transfer, step, early_termination,
     """Two-pass shear rendering (arguments validated by :func:`vrlib.render`). ``step`` sets
     the lattice of the image plane only: samples along a ray are the volume's slices.
     ``intermediate`` as for :func:`render_shear3`."""
-    ntaps = _check(view, filt, _AFFINE_ONLY)
+    ntaps = _check(view, filt, _AFFINE_ONLY, transfer)
     dtype = _intermediate(intermediate, volume)
     start = time.perf_counter()
     ds = step * float(volume.spacing.min())
@@ -395,7 +398,7 @@ def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
 
     min_opacity = _validate.finite_number("min_opacity", min_opacity, low=0.0, high=1.0,
                                           high_open=True)
-    ntaps = _check(view, filt)
+    ntaps = _check(view, filt, transfer=transfer)
     start = time.perf_counter()
     axis, ascending = major_axis(volume, view)
     scale, di, dj, (oi, oj), (height, width), kf, rays = _intermediate_plane(
