@@ -1,14 +1,7 @@
-"""The report's verdict rule (tests/claims/conftest.py), on made-up outcomes."""
+"""The report's verdict rule (tests/claim_verdicts.py), on made-up outcomes."""
 
-import importlib.util
-from pathlib import Path
-
+import claim_verdicts as rules
 import pytest
-
-spec = importlib.util.spec_from_file_location(
-    "claims_conftest", Path(__file__).parent / "claims" / "conftest.py")
-rules = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(rules)
 
 
 def outcomes_of(*pairs):

@@ -1,9 +1,10 @@
-"""Records each claim test's outcome, so that the report's verdicts come from the tests.
+"""Records each claim test's outcome, so that the report's verdicts come from the tests
+(a pytest plugin, loaded by ``tests/conftest.py``).
 
-Every test here carries ``@pytest.mark.claim(number, role)``: ``"supports"`` (it checks a
-part of the thesis's claim that holds), ``"refutes"`` (it checks a part that does not hold:
-its passing means that part is not reproduced) or ``"beyond"`` (it checks something the
-package adds where the thesis's own version is unknown). With ``VRLIB_VERDICTS=path`` set,
+Every test in ``tests/claims/`` carries ``@pytest.mark.claim(number, role)``:
+``"supports"`` (it checks a part of the thesis's claim that holds), ``"refutes"`` (it checks a
+part that does not hold: its passing means that part is not reproduced) or ``"beyond"`` (it
+checks something the package adds where the thesis's own version is unknown). With ``VRLIB_VERDICTS=path`` set,
 the outcomes and each claim's verdict are written there as JSON when the session ends.
 """
 
@@ -14,6 +15,8 @@ from pathlib import Path
 import pytest
 
 from vrlib._io import atomic_path
+
+CLAIMS_DIR = Path(__file__).resolve().parent / "claims"
 
 CLAIMS = {
     1: "A separable cubic filter reconstructs more accurately than a pyramid or a Gaussian "
@@ -48,7 +51,7 @@ def verdict(tests):
 
 def pytest_collection_modifyitems(items):
     for item in items:
-        if Path(str(item.fspath)).resolve().parent != Path(__file__).resolve().parent:
+        if Path(str(item.fspath)).resolve().parent != CLAIMS_DIR:
             continue
         mark = item.get_closest_marker("claim")
         if mark is None or mark.args[0] not in CLAIMS or mark.args[1] not in ROLES:
@@ -60,7 +63,7 @@ def pytest_runtest_logreport(report):
     if report.when != "call" and not (report.when == "setup" and report.outcome != "passed"):
         return
     path = Path(report.fspath).resolve()
-    if path.parent != Path(__file__).resolve().parent:
+    if path.parent != CLAIMS_DIR:
         return
     _OUTCOMES.append({"nodeid": report.nodeid, "outcome": report.outcome})
 
