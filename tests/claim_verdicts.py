@@ -4,8 +4,9 @@
 Every test in ``tests/claims/`` carries ``@pytest.mark.claim(number, role)``:
 ``"supports"`` (it checks a part of the thesis's claim that holds), ``"refutes"`` (it checks a
 part that does not hold: its passing means that part is not reproduced) or ``"beyond"`` (it
-checks something the package adds where the thesis's own version is unknown). With ``VRLIB_VERDICTS=path`` set,
-the outcomes and each claim's verdict are written there as JSON when the session ends.
+checks something the package adds where the thesis's own version is unknown). With
+``VRLIB_VERDICTS=path`` set, the outcomes and each claim's verdict are written there as JSON
+when the session ends.
 """
 
 import json
