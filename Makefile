@@ -35,7 +35,7 @@ DOCS := $(shell find docs -type f -not -path 'docs/_build/*')
 REPORT := build/report/html/index.html
 VERDICTS := build/results/claims/verdicts.json
 
-.PHONY: all venv results report test test-all bench lint clean distclean
+.PHONY: all venv results report report-check test test-all bench lint clean distclean
 
 all: results report
 
@@ -77,6 +77,14 @@ $(REPORT): $(DOCS) $(RESULTS) $(VERDICTS) $(LIBRARY) $(INSTALLED)
 	$(PY) -m sphinx -W --keep-going -q -b html -d build/report/doctrees docs build/report/html.tmp
 	@rm -rf build/report/html && mv build/report/html.tmp build/report/html
 	@echo "report: $(REPORT)"
+
+# Every report page rendered in headless Chromium (installed from Debian if missing): fails on
+# a blank page or a broken image.
+report-check: $(REPORT)
+	@command -v chromium >/dev/null 2>&1 || (apt-get update -qq && apt-get install -y -qq \
+		chromium >/dev/null) || (echo "report-check needs chromium (apt-get install chromium)"; \
+		exit 1)
+	$(PY) docs/report_check.py build/report/html
 
 test: $(INSTALLED)
 	$(PY) -m pytest -m "not slow"

@@ -43,7 +43,8 @@ def main():
             field = data_gen.make_field(kind, **params)
             volume = field.sample(n)
         view = vrlib.View.orbit(azimuth=120 if field is None else 30, elevation=15,
-                                size=SIZE, radius=volume.bounding_radius, center=volume.center)
+                                size=SIZE, zoom=1.6 if field is None else 1.0,
+                                radius=volume.bounding_radius, center=volume.center)
         if field is not None:
             reference = vrlib.render_reference(field, view, transfer=transfer)
             label = "reference renderer"
