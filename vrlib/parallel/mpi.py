@@ -47,7 +47,7 @@ from vrlib.compositing import over
 from vrlib.filters import make_filter
 from vrlib.image import Image, RenderStats
 from vrlib.parallel.decompose import interleaved_owners, screen_tiles, split
-from vrlib.parallel.traffic import swap_slots
+from vrlib.parallel.traffic import swap_halves, swap_slots
 from vrlib.raycast import BLOCK, cast_rays, coarsen, footprint_mask, taps_per_axis
 from vrlib.skipping import filter_margin, lattice_sums
 from vrlib.transfer import Glow, TransferFunction
@@ -369,14 +369,7 @@ def _binary_swap(comm, tree, rgba, order, sent):
     for r in range(int(math.log2(len(slots)))):
         partner_slot = s ^ (1 << r)
         partner = leaders[partner_slot]
-        r0, r1, c0, c1 = region
-        if r1 - r0 >= c1 - c0:
-            mid = (r0 + r1) // 2
-            halves = ((r0, mid, c0, c1), (mid, r1, c0, c1))
-        else:
-            mid = (c0 + c1) // 2
-            halves = ((r0, r1, c0, mid), (r0, r1, mid, c1))
-        keep, give = halves if s < partner_slot else halves[::-1]
+        keep, give = swap_halves(region, s < partner_slot)
         theirs, buf = _exchange(comm, partner, rgba, _content(rgba, give), sent)
         # The group whose bricks come first in the visibility order is in front.
         group = 1 << (r + 1)

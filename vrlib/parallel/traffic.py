@@ -16,7 +16,7 @@ from dataclasses import dataclass
 import numpy as np
 
 __all__ = ["Messages", "footprint_rect", "object_fragments", "binary_swap", "gather",
-           "image_static", "image_dynamic", "swap_slots"]
+           "image_static", "image_dynamic", "swap_slots", "swap_halves"]
 
 #: Most voxels projected when counting an image partition's traffic; larger volumes are
 #: counted on a sub-lattice whose every voxel stands for ``stride^3`` of them.
@@ -182,6 +182,25 @@ def swap_slots(tree):
     return slots
 
 
+def swap_halves(region, lower):
+    """One binary-swap round's split of a screen ``region`` ``(r0, r1, c0, c1)`` across its
+    longer side: ``(keep, give)``, the lower half kept by the partner with ``lower`` set.
+
+    Examples
+    --------
+    >>> swap_halves((0, 8, 0, 4), True), swap_halves((0, 8, 0, 4), False)[0]
+    (((0, 4, 0, 4), (4, 8, 0, 4)), (4, 8, 0, 4))
+    """
+    r0, r1, c0, c1 = region
+    if r1 - r0 >= c1 - c0:
+        mid = (r0 + r1) // 2
+        halves = ((r0, mid, c0, c1), (mid, r1, c0, c1))
+    else:
+        mid = (c0 + c1) // 2
+        halves = ((r0, r1, c0, mid), (r0, r1, mid, c1))
+    return halves if lower else halves[::-1]
+
+
 def binary_swap(tree, view, origin, spacing, *, bytes_per_pixel=4, bounded=True):
     """Binary swap (Ma et al. 1994) on the k-d tree's bricks, brick ``i`` on node ``i``.
 
@@ -223,14 +242,7 @@ def binary_swap(tree, view, origin, spacing, *, bytes_per_pixel=4, bounded=True)
         new_held = list(held)
         for s in range(len(slots)):
             partner = s ^ (1 << r)
-            r0, r1, c0, c1 = region[s]
-            if r1 - r0 >= c1 - c0:
-                mid = (r0 + r1) // 2
-                halves = ((r0, mid, c0, c1), (mid, r1, c0, c1))
-            else:
-                mid = (c0 + c1) // 2
-                halves = ((r0, r1, c0, mid), (r0, r1, mid, c1))
-            keep, give = (halves[0], halves[1]) if s < partner else (halves[1], halves[0])
+            keep, give = swap_halves(region[s], s < partner)
             part = _intersect(give, held[s]) if bounded else give
             src.append(leader[s])
             dst.append(leader[partner])
