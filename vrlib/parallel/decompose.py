@@ -285,8 +285,8 @@ class ScreenTiles:
     Examples
     --------
     >>> tiles = screen_tiles(8, 8, 2)
-    >>> tiles.rects(1), tiles.overlaps((2, 6, 0, 8))
-    ([(0, 8, 4, 8)], [(0, 0, 16), (0, 1, 16)])
+    >>> tiles.rects(1), tiles.nodes
+    ([(0, 8, 4, 8)], 2)
     """
 
     rows: np.ndarray
@@ -302,24 +302,6 @@ class ScreenTiles:
         """Pixel rectangles ``(r0, r1, c0, c1)`` owned by ``node``."""
         return [(int(self.rows[i]), int(self.rows[i + 1]), int(self.cols[j]),
                  int(self.cols[j + 1])) for i, j in np.argwhere(self.owner == node)]
-
-    def overlaps(self, rect):
-        """Tiles ``(i, j, pixels)`` meeting the pixel rectangle ``(r0, r1, c0, c1)``."""
-        r0, r1, c0, c1 = rect
-        if r1 <= r0 or c1 <= c0:
-            return []
-        i0 = np.searchsorted(self.rows, r0, side="right") - 1
-        i1 = np.searchsorted(self.rows, r1, side="left")
-        j0 = np.searchsorted(self.cols, c0, side="right") - 1
-        j1 = np.searchsorted(self.cols, c1, side="left")
-        out = []
-        for i in range(i0, i1):
-            h = min(r1, self.rows[i + 1]) - max(r0, self.rows[i])
-            for j in range(j0, j1):
-                w = min(c1, self.cols[j + 1]) - max(c0, self.cols[j])
-                if h > 0 and w > 0:
-                    out.append((i, j, int(h * w)))
-        return out
 
 
 def screen_tiles(height, width, nodes, *, layout="contiguous", tile=16):
