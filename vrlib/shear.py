@@ -214,13 +214,14 @@ def _intermediate(intermediate, volume):
     _validate.choice("intermediate", intermediate, ("auto", *INTERMEDIATES))
     if intermediate != "auto":
         return INTERMEDIATES[intermediate]
-    lo, hi = volume.value_range
-    largest = max(abs(lo), abs(hi))
-    data = np.abs(volume.data)
-    smallest = float(data[data > 0].min()) if largest > 0 else 1.0
-    if largest > _FLOAT32_SAFE[1] or smallest < _FLOAT32_SAFE[0]:
-        return np.float64
-    return np.float32
+    derived = volume._derived  # read once per volume (its samples are read-only)
+    if "float32_safe" not in derived:
+        lo, hi = volume.value_range
+        largest = max(abs(lo), abs(hi))
+        data = np.abs(volume.data)
+        smallest = float(data[data > 0].min()) if largest > 0 else 1.0
+        derived["float32_safe"] = _FLOAT32_SAFE[0] <= smallest and largest <= _FLOAT32_SAFE[1]
+    return np.float32 if derived["float32_safe"] else np.float64
 
 
 def render_shear3(volume, view, *, filt, transfer, step, early_termination,

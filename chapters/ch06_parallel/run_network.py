@@ -42,8 +42,10 @@ CLASSES = {
 }
 
 
-def frame(name, nodes, n, view, tiles):
-    """Messages of one frame and the model's total bytes (Cauchy and view-exact)."""
+def frame(name, nodes, n, angles, tiles):
+    """Messages of one frame seen from ``angles`` (azimuth, elevation) and the model's total
+    bytes (Cauchy and view-exact)."""
+    view = View.orbit(azimuth=angles[0], elevation=angles[1], size=WIDTH)
     origin = np.array([-1.0, -1.0, -1.0])
     spacing = np.full(3, 2.0 / (n - 1))
     cells = (n - 1,) * 3
@@ -75,16 +77,13 @@ def frame(name, nodes, n, view, tiles):
         total = model.image_static_frame(nodes, n**3, tile=tile, reach=reach,
                                          bytes_per_voxel=VOXEL_BYTES)[1]
         return msgs, total, total
-    after = View.orbit(azimuth=view_angles[0] + TURN, elevation=view_angles[1], size=WIDTH)
+    after = View.orbit(azimuth=angles[0] + TURN, elevation=angles[1], size=WIDTH)
     msgs = traffic.image_dynamic(tiles, view, after, (n,) * 3, origin, spacing,
                                  bytes_per_voxel=VOXEL_BYTES)
     total = model.image_dynamic_frame(nodes, n**3, dtheta=math.radians(TURN), depth=2.0,
                                       tile_width=tile, pixel=pixel,
                                       bytes_per_voxel=VOXEL_BYTES)[1]
     return msgs, total, total
-
-
-view_angles = VIEWS[0]
 
 
 def fit(nodes, values):
@@ -97,7 +96,6 @@ def fit(nodes, values):
 
 
 def main():
-    global view_angles
     rows = []
     jobs = [(p, name) for p in NODES for name in CLASSES]
     for nodes, name in progress(jobs, "frames"):
@@ -110,10 +108,9 @@ def main():
             sums = {"total": 0.0, "max": 0.0, "mean": 0.0, "bisection": 0.0, "cauchy": 0.0,
                     "exact": 0.0, "model_mean": 0.0, "model_bisection": 0.0,
                     "max_sent": 0.0, "seconds": 0.0}
-            for view_angles in VIEWS:
-                view = View.orbit(azimuth=view_angles[0], elevation=view_angles[1], size=WIDTH)
+            for angles in VIEWS:
                 start = time.perf_counter()
-                msgs, cauchy, exact = frame(name, nodes, n, view, tiles)
+                msgs, cauchy, exact = frame(name, nodes, n, angles, tiles)
                 load = net.route(msgs.src, msgs.dst, msgs.bytes)
                 sums["seconds"] += time.perf_counter() - start
                 predicted = model.channel_loads(msgs.total, nodes, torus=torus)
