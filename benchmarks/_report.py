@@ -4,7 +4,7 @@ import json
 import time
 from pathlib import Path
 
-from vrlib._io import atomic_path
+from vrlib.atomic import atomic_path
 
 ROOT = Path(__file__).resolve().parent.parent
 

@@ -18,7 +18,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 
-from vrlib._io import atomic_path  # noqa: E402
+from vrlib.atomic import atomic_path  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 

@@ -14,7 +14,7 @@ import numpy as np
 from scipy import special
 
 from vrlib import _validate
-from vrlib.volume import DEFAULT_EXTENT, Volume, _check_extent
+from vrlib.volume import DEFAULT_EXTENT, Volume, check_extent
 
 __all__ = [
     "Field",
@@ -111,7 +111,7 @@ class Field:
             raise ValueError(f"shape must be an int or (nz, ny, nx), got {shape!r}")
         if np.dtype(dtype) not in (np.dtype(np.float32), np.dtype(np.float64)):
             raise ValueError(f"dtype must be float32 or float64, got {np.dtype(dtype)}")
-        ext = _check_extent(self.bounds if extent is None else extent)
+        ext = check_extent(self.bounds if extent is None else extent)
         data = self.sample_region(shape, [(0, n) for n in shape], extent=ext, dtype=dtype)
         return Volume(data, ext, copy=False)
 
@@ -130,7 +130,7 @@ class Field:
         ((3, 9, 2), True)
         """
         shape = tuple(int(n) for n in shape)
-        ext = _check_extent(self.bounds if extent is None else extent)
+        ext = check_extent(self.bounds if extent is None else extent)
         region = [(int(a), int(b)) for a, b in region]
         if len(region) != 3 or any(not 0 <= a < b <= n for (a, b), n in zip(region, shape,
                                                                            strict=True)):
@@ -213,7 +213,7 @@ class GaussianBlob(Field):
     def integral(self, extent=None):
         if extent is None:
             return self.amplitude * (2 * math.pi) ** 1.5 * self.sigma**3
-        ext = _check_extent(extent)
+        ext = check_extent(extent)
         s2 = self.sigma * math.sqrt(2.0)
         total = self.amplitude
         for (lo, hi), c in zip(ext, self.center, strict=True):

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import pytest
 
-from vrlib._io import atomic_path
+from vrlib.atomic import atomic_path
 
 CLAIMS_DIR = Path(__file__).resolve().parent / "claims"
 

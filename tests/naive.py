@@ -109,9 +109,9 @@ def splat_naive(volume, view, filt, transfer, mode):
     composites each voxel's ``1 - exp(-density(f_i) FP)`` at once, colour ``E(f_i)``.
     """
     from vrlib.footprint import footprint
-    from vrlib.splat import major_axis
+    from vrlib.view import principal_axis
 
-    axis, ascending = major_axis(volume, view)
+    axis, ascending = principal_axis(view, volume)
     spacing = volume.spacing
     radial = filt.name == "gaussian" and np.ptp(spacing) == 0.0
     fp = footprint(filt, spacing, None if radial else view.basis)
@@ -242,9 +242,9 @@ def shearwarp_naive(volume, view, filt, transfer):
     slice, resamples the slice where the ray meets it with the 2-D filter and composites front
     to back, each segment as long as the ray's path between slices (half on the end slices);
     then the intermediate image is sampled bilinearly where each pixel's ray meets the plane."""
-    from vrlib.splat import major_axis
+    from vrlib.view import principal_axis
 
-    axis, ascending = major_axis(volume, view)
+    axis, ascending = principal_axis(view, volume)
     p_axis, q_axis = [a for a in range(3) if a != axis]
     axes = [q_axis, p_axis, axis]
     slices = np.transpose(np.asarray(volume.data, float),
@@ -304,3 +304,18 @@ def shearwarp_naive(volume, view, filt, transfer):
               + ty * ((1 - tx) * inter[j0 + 1, i0] + tx * inter[j0 + 1, i0 + 1]))
     out[inside] = sample[inside]
     return np.clip(out, 0.0, 1.0)
+
+
+#: Each method's naive twin as ``twin(volume, view, filt, transfer)``, at :func:`vrlib.render`'s
+#: defaults (step 0.5, sheet buffers): a new method adds its twin here.
+TWINS = {
+    "raycast": lambda volume, view, filt, transfer: raycast_naive(volume, view, filt, transfer,
+                                                                  0.5),
+    "splat": lambda volume, view, filt, transfer: splat_naive(volume, view, filt, transfer,
+                                                              "sheet"),
+    "shear3": lambda volume, view, filt, transfer: shear_naive(volume, view, filt, transfer,
+                                                               0.5, 3),
+    "shear2": lambda volume, view, filt, transfer: shear_naive(volume, view, filt, transfer,
+                                                               0.5, 2),
+    "shearwarp": shearwarp_naive,
+}

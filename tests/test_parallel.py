@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from vrlib import View
-from vrlib.parallel import decompose, model, network, taxonomy, traffic
+from vrlib.parallel import composite, decompose, model, network, taxonomy, traffic
 
 ORIGIN = np.array([-1.0, -1.0, -1.0])
 
@@ -175,11 +175,11 @@ def test_classic_binary_swap_sends_w2_one_minus_one_over_p():
     view = View.orbit(azimuth=30, elevation=20, size=64)
     for parts in (2, 4, 8, 16):
         tree = decompose.split((32, 32, 32), parts)
-        msgs = traffic.binary_swap(tree, view, origin, spacing, bounded=False)
+        msgs = composite.binary_swap_messages(tree, view, origin, spacing, bounded=False)
         per_node = msgs.sent_per_node(parts)
         np.testing.assert_allclose(per_node, 64 * 64 * 4 * (1 - 1 / parts))
         assert model.binary_swap_frame(parts, 64, 64)[0] == per_node[0]
-        bounded = traffic.binary_swap(tree, view, origin, spacing).total
+        bounded = composite.binary_swap_messages(tree, view, origin, spacing).total
         assert bounded < msgs.total
 
 
@@ -194,9 +194,9 @@ def test_direct_send_matches_the_bounding_rectangle_model():
     for parts, shape in [(64, "blocks"), (64, "shafts"), (16, "slabs")]:
         grid = decompose.grid_shape(parts, shape)
         tree = decompose.split((n - 1,) * 3, parts, grid=grid)
-        msgs, local = traffic.object_fragments(tree, np.arange(parts),
-                                               decompose.screen_tiles(512, 512, parts), view,
-                                               origin, spacing)
+        msgs, local = composite.direct_send_messages(tree, np.arange(parts),
+                                                     decompose.screen_tiles(512, 512, parts),
+                                                     view, origin, spacing)
         _, total = model.object_frame(grid, side=2.0, pixel=view.pixel_size, view=view)
         assert msgs.total == pytest.approx(total, rel=0.05)
 

@@ -15,12 +15,13 @@ from mpi4py import MPI
 
 import data_gen
 import vrlib
-from vrlib.parallel import decompose, mpi, traffic
+from vrlib.parallel import composite, decompose, mpi
 
 PROGRAMS = Path(__file__).parent / "mpi_programs"
 MPIEXEC = Path(sys.executable).parent / "mpiexec"
-CASES = [["binary-swap", "even"], ["direct-send", "even"], ["direct-send", "interleaved"],
-         ["binary-swap", "work"], ["image", None]]
+# Every compositor with even bricks, then the other balances and the image partition.
+CASES = [[name, "even"] for name in composite.COMPOSITORS] + [
+    ["direct-send", "interleaved"], ["binary-swap", "work"], ["image", None]]
 TOLERANCE = 1e-6  # the issue's; measured differences are below 1e-15
 
 
@@ -74,7 +75,7 @@ def test_ranks_with_nothing_to_show_take_part():
     assert done.returncode == 0, done.stderr
     results = json.loads(done.stdout.strip().splitlines()[-1])["results"]
     check_results(results)
-    for r in results[:2]:  # one brick per rank, cut evenly
+    for r in results[:len(composite.COMPOSITORS)]:  # one brick per rank, cut evenly
         idle = [i for i, s in enumerate(r["samples"]) if s == 0]
         assert len(idle) >= 2, r["samples"]
         if r["compositing"] == "direct-send":
@@ -109,9 +110,9 @@ def test_bytes_sent_against_the_traffic_model():
     view = vrlib.View.orbit(azimuth=35, elevation=25, size=size)
     vol = data_gen.make_field("marschner-lobb").sample(n)
     tree = decompose.split((n - 1,) * 3, ranks)
-    msgs, _ = traffic.object_fragments(tree, np.arange(ranks),
-                                       decompose.screen_tiles(size, size, ranks), view,
-                                       vol.origin, vol.spacing, bytes_per_pixel=32)
+    msgs = composite.COMPOSITORS["direct-send"].messages(
+        tree, np.arange(ranks), decompose.screen_tiles(size, size, ranks), view, vol.origin,
+        vol.spacing, bytes_per_pixel=32)
     simulated = msgs.sent_per_node(ranks)
     measured = np.array([b["composite"] for b in direct["bytes"]], dtype=float)
     assert np.all(measured <= simulated + mpi.HEADER * 2 * ranks)

@@ -16,8 +16,8 @@ from hypothesis.extra.numpy import arrays
 import vrlib
 from vrlib.compositing import composite
 
-METHODS = ["raycast", "splat", "shear3", "shear2", "shearwarp"]
-FILTERS = ["box", "trilinear", "gaussian", "catmull-rom", "bspline", "mitchell"]
+METHODS = list(vrlib.METHODS)
+FILTERS = list(vrlib.filters.STANDARD)
 #: Examples per rendering property: bounded in ``make test``, many more in ``make test-all``.
 RENDERS = settings(max_examples=300 if os.environ.get("HYPOTHESIS_PROFILE") == "thorough"
                    else 20)

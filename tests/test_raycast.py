@@ -10,7 +10,8 @@ from naive import exact_blob_image, image_mass, random_orbits, raycast_naive
 import data_gen
 import vrlib
 from vrlib import Glow, LookupTransfer, Phong, View, Volume, metrics, render, render_reference
-from vrlib.raycast import cast_rays, reconstructed_range
+from vrlib.raycast import cast_rays
+from vrlib.value_bounds import reconstructed_range
 
 FILTERS = ["box", "trilinear", "catmull-rom", "bspline", "mitchell", "gaussian",
            ("mitchell-netravali", 0.2, 0.6), ("gaussian", 0.5, 1.5)]
@@ -203,7 +204,7 @@ def test_stats_are_counted():
     [
         ({"method": "raytrace"}, ValueError, "unknown method 'raytrace'; known: 'raycast'"),
         ({"filter": "cubic"}, ValueError, "unknown filter 'cubic'; known:"),
-        ({"filter": ("gaussian", 0.6, 5.0)}, ValueError, "ray casting takes at most 8"),
+        ({"filter": ("gaussian", 0.6, 5.0)}, ValueError, "radius 5 is out of range"),
         ({"step": 0.0}, ValueError, "step must be > 0"),
         ({"step": -1.0}, ValueError, "step must be > 0"),
         ({"step": math.nan}, ValueError, "step must be finite"),

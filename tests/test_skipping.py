@@ -5,7 +5,8 @@ import pytest
 from naive import reconstruct_naive
 
 from vrlib import Glow, LookupTransfer, Volume, make_filter
-from vrlib.skipping import empty_blocks, filter_margin, lattice_sums
+from vrlib.skipping import empty_blocks
+from vrlib.value_bounds import lattice_sums
 
 
 def test_lattice_sums_of_known_filters():
@@ -22,9 +23,9 @@ def test_lattice_sums_of_known_filters():
 
 
 def test_filter_margin():
-    margins = [filter_margin(make_filter(f)) for f in ["box", "trilinear", "catmull-rom"]]
+    margins = [make_filter(f).margin for f in ["box", "trilinear", "catmull-rom"]]
     assert margins == [0, 0, 1]
-    assert filter_margin(make_filter("gaussian", sigma=0.5, radius=2.5)) == 2
+    assert make_filter("gaussian", sigma=0.5, radius=2.5).margin == 2
 
 
 @pytest.mark.parametrize("filt", ["box", "trilinear", "catmull-rom", "mitchell", "gaussian",

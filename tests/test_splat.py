@@ -10,7 +10,7 @@ import data_gen
 import vrlib
 from vrlib import Glow, LookupTransfer, Phong, View, Volume, metrics, render
 from vrlib.footprint import PLANAR, RADIAL, footprint
-from vrlib.splat import major_axis
+from vrlib.view import principal_axis
 
 TABLE = LookupTransfer([0.0, 3.0, 1.0, 5.0], [[1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 1]])
 FILTERS = ["box", "trilinear", "catmull-rom", "bspline", "gaussian", ("gaussian", 0.5, 1.5)]
@@ -236,12 +236,12 @@ def test_axis_aligned_and_tied_views(azimuth, elevation):
     assert metrics.max_abs_error(at, near) < 1e-5
 
 
-def test_major_axis_and_order():
+def test_principal_axis_and_order():
     vol = Volume(np.zeros((4, 4, 4)))
-    assert major_axis(vol, View.orbit(azimuth=0, elevation=0)) == (0, False)
-    assert major_axis(vol, View.orbit(azimuth=180, elevation=10)) == (0, True)
-    assert major_axis(vol, View.orbit(azimuth=0, elevation=-80)) == (2, True)
-    assert major_axis(vol, View.orbit(azimuth=45, elevation=0))[0] == 0  # tie -> lower axis
+    assert principal_axis(View.orbit(azimuth=0, elevation=0), vol) == (0, False)
+    assert principal_axis(View.orbit(azimuth=180, elevation=10), vol) == (0, True)
+    assert principal_axis(View.orbit(azimuth=0, elevation=-80), vol) == (2, True)
+    assert principal_axis(View.orbit(azimuth=45, elevation=0), vol)[0] == 0  # tie -> lower axis
 
 
 @pytest.mark.parametrize(

@@ -21,7 +21,7 @@ from vrlib import bounds, compositing, cost, filters, metrics
 from vrlib.filters import FILTERS, make_filter
 from vrlib.image import Image, RenderStats
 from vrlib.reference import render_reference
-from vrlib.render import METHODS, render
+from vrlib.render import METHODS, reference_image, render
 from vrlib.transfer import Glow, LookupTransfer, Phong, TransferFunction
 from vrlib.view import View
 from vrlib.volume import Volume
@@ -31,6 +31,7 @@ __version__ = "0.1.0"
 __all__ = [
     "render",
     "render_reference",
+    "reference_image",
     "METHODS",
     "Volume",
     "View",

@@ -27,7 +27,6 @@ from scipy.spatial import ConvexHull
 
 from vrlib import _validate
 from vrlib.filters import make_filter
-from vrlib.raycast import taps_per_axis
 
 __all__ = ["feature_error", "fourier_bound", "required_ratio", "error_samples"]
 
@@ -75,10 +74,10 @@ def error_samples(filt, ratio, *, offsets=_OFFSETS, per_sample=_PER_SAMPLE):
     f = np.exp(-0.5 * ((x - centres) / sigma) ** 2)
     # R(x) = sum_n f(n) k(x - n) over the filter's taps: the weights depend on x alone.
     first = np.floor(x - filt.radius).astype(np.int64) + 1
-    lattice = np.arange(first.min(), first.max() + taps_per_axis(filt))
+    lattice = np.arange(first.min(), first.max() + filt.taps)
     samples = np.exp(-0.5 * ((lattice - centres) / sigma) ** 2)
     r = np.zeros_like(f)
-    for tap in range(taps_per_axis(filt)):
+    for tap in range(filt.taps):
         n = first + tap
         r += filt(x - n) * samples[:, n - lattice[0]]
     return f, r

@@ -8,7 +8,7 @@ from __future__ import annotations
 import argparse
 import platform
 import sys
-import time
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -143,15 +143,16 @@ def _add_scene(parser):
 
 def cmd_render(args):
     import vrlib
+    from vrlib.cost import measure
 
     if Path(args.output).suffix.lower() not in (".png", ".npy"):
         raise UsageError(f"output must end in .png or .npy, got {args.output!r}")
     volume, _ = load_volume(args.volume, shape=args.shape, dtype=args.dtype)
     view = make_view(args, volume)
-    start = time.perf_counter()
-    img = vrlib.render(volume, view, method=args.method, filter=args.filter,
-                       transfer=make_transfer(args.transfer, args.shade)(volume), step=args.step)
-    seconds = time.perf_counter() - start
+    seconds, img = measure(partial(
+        vrlib.render, volume, view, method=args.method, filter=args.filter,
+        transfer=make_transfer(args.transfer, args.shade)(volume), step=args.step),
+        repeats=1, warmup=False)
     img.save(args.output, bits=args.bits)
     print(f"{args.output}: {view.width}x{view.height} {args.method}/{args.filter} "
           f"in {seconds:.3f} s")
@@ -172,28 +173,23 @@ def cmd_compare(args):
     from tqdm import tqdm
 
     import vrlib
-    from vrlib._io import atomic_path
+    from vrlib.atomic import atomic_path
+    from vrlib.cost import measure
 
     volume, field = load_volume(args.volume, shape=args.shape, dtype=args.dtype)
     view = make_view(args, volume)
     transfer = make_transfer(args.transfer, args.shade)(volume)
-    if field is not None:
-        reference = vrlib.render_reference(field, view, transfer=transfer)
-        label = "reference renderer (exact field)"
-    else:
-        reference = vrlib.render(volume, view, filter="catmull-rom", transfer=transfer,
-                                 step=0.125, early_termination=1.0)
-        label = "ray casting, Catmull-Rom, step 1/8 (no exact field for a file)"
+    reference, label = vrlib.reference_image(volume, view, transfer=transfer, field=field)
+    label += " (exact field)" if field is not None else ", Catmull-Rom (no exact field for a file)"
     rows, images = [], {}
     for method in tqdm(vrlib.METHODS, desc="methods", file=sys.stderr, disable=None):
-        start = time.perf_counter()
         try:
-            img = vrlib.render(volume, view, method=method, filter=args.filter,
-                               transfer=transfer, step=args.step)
+            seconds, img = measure(partial(vrlib.render, volume, view, method=method,
+                                           filter=args.filter, transfer=transfer,
+                                           step=args.step), repeats=1, warmup=False)
         except ValueError as error:
             rows.append((method, None, None, None, str(error)))
             continue
-        seconds = time.perf_counter() - start
         images[method] = img
         err = _errors(img, reference)
         rows.append((method, seconds, err["rmse"], err["max"], ""))
@@ -229,6 +225,7 @@ def cmd_bench(args):
 
     import data_gen
     import vrlib
+    from vrlib.cost import measure
 
     field = data_gen.make_field("marschner-lobb")
     volume = field.sample(args.samples)
@@ -238,13 +235,8 @@ def cmd_bench(args):
     runs = [(m, f) for m in vrlib.METHODS for f in ("trilinear", "catmull-rom")]
     rows = []
     for method, filt in tqdm(runs, desc="bench", file=sys.stderr, disable=None):
-        vrlib.render(volume, view, method=method, filter=filt, transfer=transfer)  # compile
-        best = None
-        for _ in range(args.repeats):
-            start = time.perf_counter()
-            img = vrlib.render(volume, view, method=method, filter=filt, transfer=transfer)
-            seconds = time.perf_counter() - start
-            best = seconds if best is None else min(best, seconds)
+        best, img = measure(partial(vrlib.render, volume, view, method=method, filter=filt,
+                                    transfer=transfer), repeats=args.repeats)
         rows.append((method, filt, best, vrlib.metrics.rmse(img, reference)))
     print(f"Marschner-Lobb {args.samples}^3 -> {args.size}^2, best of {args.repeats}, "
           f"rmse against the reference renderer")

@@ -4,7 +4,8 @@ A *reconstructed point* is one value of the reconstructed field that a renderer 
 into the image: a ray sample (ray casting), a footprint pixel (splatting: one voxel's kernel
 integrated along one pixel's ray), a sample of the final lattice (three- and two-pass
 shearing) or of a slice on the intermediate image (shear-warp). Every renderer counts its own
-points and operations in :class:`vrlib.RenderStats`; :func:`points` reads them back.
+points and operations in :class:`vrlib.RenderStats` (``points``, ``operations``), so a new
+renderer needs nothing here.
 
 The model (the thesis's question, the brief's section 6): a frame costs
 ``t = c_op * operations + c_pt * points + c_0``, with per-machine constants fitted to
@@ -58,30 +59,31 @@ def machine():
             "system": f"{platform.system()} {platform.release()}"}
 
 
-def points(method, stats):
+def points(stats):
     """Reconstructed points of one render, from its statistics (module docstring).
 
     Examples
     --------
     >>> from vrlib import RenderStats
-    >>> points("shear3", RenderStats(samples=130, voxels=100, passes={"pass1": 40}))
+    >>> points(RenderStats(samples=130, voxels=100, points=30))
     30
+    >>> points(RenderStats(samples=130))
+    130
     """
-    _validate.choice("method", method, ("raycast", "splat", "shear3", "shear2", "shearwarp"))
-    if method in ("shear3", "shear2"):
-        return int(stats.samples - stats.voxels)  # samples = resampled + composited
-    return int(stats.samples)
+    return int(stats.points)
 
 
-def measure(render, *, repeats=3):
-    """Time ``render()`` (a callable returning an :class:`vrlib.Image`): the best of
-    ``repeats`` runs after one warm-up run (which compiles the kernels).
+def measure(render, *, repeats=3, warmup=True):
+    """Time ``render()`` (any callable; usually one returning an :class:`vrlib.Image`): the
+    best of ``repeats`` runs, after one warm-up run (which compiles the kernels) unless
+    ``warmup`` is False. The one timing loop of the package: chapters, benchmarks and the
+    command line all time with it.
 
     Returns
     -------
     seconds : float
     image : Image
-        The last run's image, with its statistics.
+        What the last run returned (an image, with its statistics).
 
     Examples
     --------
@@ -93,7 +95,8 @@ def measure(render, *, repeats=3):
     True
     """
     repeats = _validate.positive_int("repeats", repeats)
-    image = render()
+    if warmup:
+        render()
     best = float("inf")
     for _ in range(repeats):
         start = time.perf_counter()

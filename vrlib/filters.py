@@ -5,13 +5,21 @@ Every filter is an even 1-D kernel ``k(x)`` in voxel units; a 3-D filter is the 
 interface:
 
 * ``f(x)``: weights (NumPy, vectorised); ``f.derivative(x)``;
-* ``f.radius``: support radius in voxels (``k`` vanishes for ``|x| >= radius``);
+* ``f.radius``: support radius in voxels (``k`` vanishes for ``|x| >= radius``); ``f.taps``,
+  the lattice samples per axis it can weight at one point, and ``f.margin``, the samples it
+  reaches beyond a cell's corners;
 * ``f.integral()``: the integral of ``k`` over the line;
 * ``f.frequency_response(omega)``: the analytic Fourier transform, ``omega`` in radians per
   sample (the Nyquist frequency is pi);
 * ``f.interpolating`` and ``f.partition_of_unity``: what theory says of the kernel;
 * ``f.code``: ``(kind, p0, p1, p2)`` scalars that the numba kernels evaluate with
   :func:`vrlib._kernels.filters.weight`.
+
+Every renderer takes filters up to :data:`MAX_RADIUS` voxels (:func:`check_radius`).
+
+Adding a filter: a class here (the interface above; a piecewise polynomial needs only its
+``pieces``) and an entry in :data:`FILTERS`. Chapters, the command line and the cost model read
+:data:`FILTERS`; a kernel formula is needed only for a new ``kind`` of ``code``.
 
 "Pyramid filter" in the volume-rendering literature of the thesis's time is the product of
 tents, i.e. trilinear interpolation; a true pyramid ``1 - max |x_i|`` does not sum to one over
@@ -35,8 +43,14 @@ __all__ = [
     "Gaussian",
     "MitchellNetravali",
     "FILTERS",
+    "STANDARD",
+    "MAX_RADIUS",
     "make_filter",
+    "check_radius",
 ]
+
+#: Largest filter radius (voxels) the renderers take: the kernels' tap limit over two.
+MAX_RADIUS = _k.MAX_TAPS / 2
 
 
 class Filter:
@@ -56,6 +70,28 @@ class Filter:
     def params(self):
         """The filter's parameters as a dict (empty for parameter-free filters)."""
         return {}
+
+    @property
+    def taps(self):
+        """Lattice samples per axis that the filter can weight at one point: ``ceil(2 r)``.
+
+        Examples
+        --------
+        >>> make_filter("trilinear").taps, make_filter("catmull-rom").taps
+        (2, 4)
+        """
+        return max(1, math.ceil(2.0 * self.radius))
+
+    @property
+    def margin(self):
+        """Samples beyond a cell's corners that the filter reaches: ``ceil(r) - 1``.
+
+        Examples
+        --------
+        >>> make_filter("trilinear").margin, make_filter("catmull-rom").margin
+        (0, 1)
+        """
+        return max(0, math.ceil(self.radius) - 1)
 
     def __call__(self, x):
         """Weights ``k(x)`` for offsets ``x`` in voxels (array in, array out)."""
@@ -242,10 +278,8 @@ class MitchellNetravali(_Piecewise):
         self.B = _validate.finite_number("B", B)
         self.C = _validate.finite_number("C", C)
         self.name = name
-        b, c = self.B, self.C
-        # The two cubic pieces of the brief's formula, divided by 6, ascending powers.
-        near = (6 - 2 * b, 0.0, -18 + 12 * b + 6 * c, 12 - 9 * b - 6 * c)
-        far = (8 * b + 24 * c, -12 * b - 48 * c, 6 * b + 30 * c, -b - 6 * c)
+        # The two cubic pieces (the kernels' one definition), divided by 6, ascending powers.
+        near, far = _k.cubic_coefficients(self.B, self.C)
         self.pieces = (
             (0.0, 1.0, tuple(v / 6 for v in near)),
             (1.0, 2.0, tuple(v / 6 for v in far)),
@@ -356,10 +390,27 @@ FILTERS = {
     "trilinear": Pyramid,
     "gaussian": Gaussian,
     "catmull-rom": _catmull_rom,
-    "bspline": _bspline,
     "mitchell": _mitchell,
+    "bspline": _bspline,
     "mitchell-netravali": MitchellNetravali,
 }
+
+
+def _standard():
+    names = []
+    for name, build in FILTERS.items():
+        try:
+            filt = build()
+        except TypeError:  # a family that needs its parameters
+            continue
+        if filt.name == name:  # an alias builds a filter of another name
+            names.append(name)
+    return tuple(names)
+
+
+#: The distinct filters that build by name alone (no alias, no parametric family), in the
+#: order of :data:`FILTERS`: the set chapters, the command line and the cost model compare.
+STANDARD = _standard()
 
 
 def make_filter(spec, *args, **params):
@@ -406,3 +457,19 @@ def make_filter(spec, *args, **params):
         return FILTERS[spec](*args, **params)
     except TypeError as exc:
         raise TypeError(f"bad parameters for filter {spec!r}: {exc}") from None
+
+
+def check_radius(filt):
+    """Refuse a filter wider than the renderers take (:data:`MAX_RADIUS`); return it.
+
+    Examples
+    --------
+    >>> check_radius(make_filter("gaussian", radius=5.0))
+    Traceback (most recent call last):
+    ...
+    ValueError: filter radius 5 is out of range: the renderers take radii up to 4 voxels
+    """
+    if filt.radius > MAX_RADIUS:
+        raise ValueError(f"filter radius {filt.radius:g} is out of range: the renderers take "
+                         f"radii up to {MAX_RADIUS:g} voxels")
+    return filt

@@ -8,8 +8,8 @@ from pathlib import Path
 import numpy as np
 
 from vrlib import _validate
-from vrlib._io import atomic_path
 from vrlib._png import encode_png
+from vrlib.atomic import atomic_path
 
 __all__ = ["Image", "RenderStats"]
 
@@ -21,7 +21,8 @@ class RenderStats:
     Attributes
     ----------
     samples : int
-        Reconstructed points (ray samples, splatted voxels, resampled voxels...).
+        Samples the renderer computed (ray samples, footprint pixels, resampled and
+        composited samples...).
     operations : int
         Arithmetic operations by the renderer's own count model.
     bytes : int
@@ -33,11 +34,16 @@ class RenderStats:
     passes : dict or None
         Shearing: samples resampled by each pass (``pass1``, ``pass2``, ``pass3``) and the
         bytes of the intermediate volumes (``buffers``).
+    points : int, optional
+        Reconstructed points composited into the image, the cost model's unit
+        (:mod:`vrlib.cost`); ``samples`` unless the renderer says otherwise (three- and
+        two-pass shearing: the composited samples, not the resampled ones).
 
     Examples
     --------
-    >>> RenderStats(samples=10, seconds=0.5).as_dict()
-    {'samples': 10, 'operations': 0, 'bytes': 0, 'seconds': 0.5, 'voxels': 0, 'passes': None}
+    >>> RenderStats(samples=10, seconds=0.5).as_dict()     # doctest: +NORMALIZE_WHITESPACE
+    {'samples': 10, 'operations': 0, 'bytes': 0, 'seconds': 0.5, 'voxels': 0, 'passes': None,
+     'points': 10}
     """
 
     samples: int = 0
@@ -46,6 +52,11 @@ class RenderStats:
     seconds: float = 0.0
     voxels: int = 0
     passes: dict | None = None
+    points: int | None = None
+
+    def __post_init__(self):
+        if self.points is None:
+            self.points = self.samples
 
     def as_dict(self):
         """The counters as a plain dict."""

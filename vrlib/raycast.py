@@ -10,7 +10,6 @@ ray termination stops a ray once its opacity reaches a threshold (the image chan
 
 from __future__ import annotations
 
-import math
 import time
 
 import numba
@@ -18,22 +17,15 @@ import numpy as np
 
 from vrlib._kernels import raycast as _kernel
 from vrlib._kernels.filters import TENT
-from vrlib._kernels.sampling import MAX_TAPS
 from vrlib._scheduling import balanced_order
 from vrlib.image import Image, RenderStats
-from vrlib.skipping import empty_blocks, lattice_sums
+from vrlib.skipping import BLOCK, coarsen, empty_blocks, footprint_mask, visible_box
+from vrlib.value_bounds import reconstructed_range
 
-__all__ = ["render_raycast", "operations_per_sample", "BLOCK"]
+__all__ = ["render_raycast", "cast_rays", "operations_per_sample"]
 
-#: Cells per block (each axis) of the empty-space skipping grid.
-BLOCK = 8
 #: Pixels (rows, columns) of the image tiles that the parallel loop hands out.
 TILE = (32, 32)
-
-
-def taps_per_axis(filt):
-    """Lattice samples per axis that a filter of this radius can weight at one point."""
-    return max(1, math.ceil(2.0 * filt.radius))
 
 
 def operations_per_sample(filt, *, shading=False):
@@ -50,69 +42,12 @@ def operations_per_sample(filt, *, shading=False):
     >>> operations_per_sample(make_filter("trilinear"))
     56
     """
-    n = taps_per_axis(filt)
+    n = filt.taps
     recon = 30 if filt.code[0] == TENT else 30 * n + 2 * (n**3 + n**2)
     ops = 6 + recon + 20
     if shading:
         ops += 30 * n + 6 * n**3 + 30
     return ops
-
-
-def reconstructed_range(volume, filt):
-    """Bounds on every value the filter can reconstruct from this volume (overshoot of
-    negative lobes and the Gaussian's ripple included; see :mod:`vrlib.skipping`)."""
-    s_min, s_max, a_max = lattice_sums(filt)
-    lo, hi = volume.value_range
-    centre, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
-    return (min(centre * s_min, centre * s_max) - a_max * half,
-            max(centre * s_min, centre * s_max) + a_max * half)
-
-
-def coarsen(empty, factor=4):
-    """Blocks of ``factor^3`` blocks that are all empty (edge blocks padded as empty)."""
-    pad = [(0, -n % factor) for n in empty.shape]
-    padded = np.pad(empty, pad, constant_values=True)
-    shape = []
-    for n in padded.shape:
-        shape += [n // factor, factor]
-    return padded.reshape(shape).all(axis=(1, 3, 5))
-
-
-def visible_box(volume, empty, block, lo, hi):
-    """World box around every non-empty block (a sliver larger, so that samples on its faces
-    are taken whatever the rounding), clipped to ``[lo, hi]``; empty if nothing is visible."""
-    full = np.argwhere(~empty)
-    if full.size == 0:
-        return lo, lo.copy()  # t_out <= t_in for every ray
-    first = full.min(axis=0)[::-1] * block  # cells, x y z
-    last = (full.max(axis=0)[::-1] + 1) * block
-    sliver = 1e-9 * (hi - lo)
-    box_lo = np.maximum(volume.origin + first * volume.spacing - sliver, lo)
-    box_hi = np.minimum(volume.origin + last * volume.spacing + sliver, hi)
-    return box_lo, box_hi
-
-
-def footprint_mask(view, volume, empty, block):
-    """Pixels whose rays can meet a non-empty block: the union of the blocks' projected
-    bounding rectangles, one pixel wider all round (exact when conservative: a ray outside it
-    crosses only empty blocks, whose samples add nothing)."""
-    full = np.argwhere(~empty)[:, ::-1]  # block indices, x y z
-    corners = np.array(np.meshgrid([0, 1], [0, 1], [0, 1], indexing="ij")).reshape(3, -1).T
-    cells = (full[:, None, :] + corners[None, :, :]) * block
-    cells = np.minimum(cells, np.array(volume.shape[::-1]) - 1)
-    projected = view.project(volume.origin + cells * volume.spacing)  # (blocks, 8, 3)
-    if not np.all(np.isfinite(projected)) or np.any(projected[..., 2] <= 0.0):
-        return np.ones(view.shape, dtype=bool)  # a block reaches behind the eye: keep all
-    r0 = np.clip(np.floor(projected[..., 0].min(axis=1)).astype(int) - 1, 0, view.height)
-    r1 = np.clip(np.floor(projected[..., 0].max(axis=1)).astype(int) + 2, 0, view.height)
-    c0 = np.clip(np.floor(projected[..., 1].min(axis=1)).astype(int) - 1, 0, view.width)
-    c1 = np.clip(np.floor(projected[..., 1].max(axis=1)).astype(int) + 2, 0, view.width)
-    marks = np.zeros((view.height + 1, view.width + 1), dtype=np.int64)
-    np.add.at(marks, (r0, c0), 1)
-    np.add.at(marks, (r0, c1), -1)
-    np.add.at(marks, (r1, c0), -1)
-    np.add.at(marks, (r1, c1), 1)
-    return marks.cumsum(axis=0).cumsum(axis=1)[:-1, :-1] > 0
 
 
 def render_raycast(volume, view, *, filt, transfer, step, early_termination,
@@ -144,7 +79,8 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
 
 def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, transfer, ds,
               value_range, early_termination, skip=None):
-    """Ray-cast samples ``data`` (all of a volume, or a brick of it with ghost samples).
+    """Ray-cast samples ``data`` (all of a volume, or a brick of it with ghost samples): the
+    ray caster's core, which the MPI renderers run on each brick or tile.
 
     Parameters
     ----------
@@ -167,12 +103,6 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
     samples : int
         Samples reconstructed.
     """
-    ntaps = taps_per_axis(filt)
-    if ntaps > MAX_TAPS:
-        raise ValueError(
-            f"filter radius {filt.radius:g} needs {ntaps} taps per axis; ray casting takes at "
-            f"most {MAX_TAPS} (radius <= {MAX_TAPS // 2})"
-        )
     tables = transfer.segment_table(ds, *value_range)
     shading = transfer.shading
     if shading is None:
@@ -199,8 +129,8 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
         np.asarray(origin, np.float64), np.asarray(spacing, np.float64),
         np.asarray(box[0], np.float64), np.asarray(box[1], np.float64), view.packed(),
         view.height, view.width,
-        ds, *filt.code, filt.radius, ntaps, *tables, *lighting, early_termination, *skip, *TILE,
-        balanced_order(costs, numba.get_num_threads()), out, samples, grey,
+        ds, *filt.code, filt.radius, filt.taps, *tables, *lighting, early_termination, *skip,
+        *TILE, balanced_order(costs, numba.get_num_threads()), out, samples, grey,
     )
     np.clip(out[..., 3], 0.0, 1.0, out=out[..., 3])
     return out, int(samples.sum())

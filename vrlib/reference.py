@@ -25,10 +25,9 @@ import time
 import numpy as np
 
 from vrlib import _validate
+from vrlib.arguments import check_transfer, check_view
 from vrlib.image import Image, RenderStats
-from vrlib.transfer import Glow, TransferFunction
-from vrlib.view import View
-from vrlib.volume import _check_extent
+from vrlib.volume import check_extent
 
 __all__ = ["render_reference"]
 
@@ -137,15 +136,12 @@ def render_reference(field, view, *, transfer=None, tol=1e-6, extent=None, segme
     """
     if not callable(field) or not hasattr(field, "bounds"):
         raise TypeError(f"field must be an analytic data_gen field, got {type(field).__name__}")
-    if not isinstance(view, View):
-        raise TypeError(f"view must be a vrlib.View, got {type(view).__name__}")
-    transfer = Glow(1.0) if transfer is None else transfer
-    if not isinstance(transfer, TransferFunction):
-        raise TypeError(f"transfer must be a vrlib transfer function, got {transfer!r}")
+    check_view(view)
+    transfer = check_transfer(transfer)
     tol = _validate.finite_number("tol", tol, low=0.0, low_open=True)
     segments = _validate.positive_int("segments", segments)
     chunk = _validate.positive_int("chunk", chunk)
-    box = _check_extent(field.bounds if extent is None else extent)
+    box = check_extent(field.bounds if extent is None else extent)
     start = time.perf_counter()
     origins, directions = view.rays()
     origins = origins.reshape(-1, 3)

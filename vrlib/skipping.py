@@ -2,65 +2,27 @@
 
 A block is empty when every value the filter can reconstruct inside it maps to zero opacity.
 The block's sample range ``[m, M]`` comes from the volume's min-max pyramid, widened by the
-filter's reach; the reconstructed value is then bounded by the filter's lattice sums: with
-weights ``w`` at a point, ``R = sum w f`` lies within
-``c * sum(w) +- sum(|w|) * h`` where ``c = (m + M) / 2`` and ``h = (M - m) / 2``. For filters
-with negative lobes (Catmull-Rom, Mitchell) this allows for overshoot; for the Gaussian, whose
-weights do not sum to one, for its ripple. The test is conservative, so skipping never changes
-an image.
+filter's reach (:attr:`vrlib.filters.Filter.margin`), and is turned into bounds on the
+reconstructed value by :func:`vrlib.value_bounds.value_bounds`. The test is conservative, so
+skipping never changes an image.
 
-Slice-by-slice renderers (shear-warp) skip along rows instead: :func:`transparent_runs` gives,
-for each row of each slice, the first and last sample above a transparency bound.
+Ray casters skip with the block grid and the geometry built from it here (the box around what
+is visible, the pixels whose rays can meet it, a coarser grid for long jumps); slice-by-slice
+renderers (shear-warp) skip along rows instead: :func:`transparent_runs` gives, for each row of
+each slice, the first and last sample above a transparency bound.
 """
 
 from __future__ import annotations
 
-import functools
-import math
-
 import numpy as np
 
-from vrlib.filters import make_filter
+from vrlib.value_bounds import value_bounds
 
-__all__ = ["empty_blocks", "lattice_sums", "filter_margin", "transparent_runs"]
+__all__ = ["BLOCK", "empty_blocks", "brick_empty_blocks", "coarsen", "visible_box",
+           "footprint_mask", "transparent_runs"]
 
-
-@functools.lru_cache(maxsize=64)
-def lattice_sums(filt):
-    """``(s_min, s_max, a_max)`` of a filter's 3-D weights over every position.
-
-    ``s`` is the sum of the weights (1 for filters that form a partition of unity) and ``a``
-    the sum of their absolute values; 3-D values are the cubes of the 1-D ones, as the filters
-    are separable. Found on a dense grid of offsets and widened by 1e-9 relative, which bounds
-    the grid's error for these smooth sums.
-
-    Examples
-    --------
-    >>> s_min, s_max, a_max = lattice_sums(make_filter("trilinear"))
-    >>> round(s_min, 6), round(s_max, 6), round(a_max, 6)
-    (1.0, 1.0, 1.0)
-    >>> lattice_sums(make_filter("catmull-rom"))[2] > 1.0     # negative lobes
-    True
-    """
-    filt = make_filter(filt)
-    offsets = np.linspace(0.0, 1.0, 4097)
-    taps = np.arange(-math.ceil(filt.radius) - 1, math.ceil(filt.radius) + 2)
-    w = filt(offsets[:, None] - taps[None, :])
-    s = w.sum(axis=1)
-    a = np.abs(w).sum(axis=1)
-    pad = 1.0 + 1e-9
-    return float(s.min() ** 3 / pad), float(s.max() ** 3 * pad), float(a.max() ** 3 * pad)
-
-
-def filter_margin(filt):
-    """Samples beyond a cell's corners that a filter of this radius reaches: ceil(r) - 1.
-
-    Examples
-    --------
-    >>> filter_margin(make_filter("trilinear")), filter_margin(make_filter("catmull-rom"))
-    (0, 1)
-    """
-    return max(0, math.ceil(make_filter(filt).radius) - 1)
+#: Cells per block (each axis) of the empty-space skipping grid.
+BLOCK = 8
 
 
 def empty_blocks(volume, filt, transfer, *, block=8):
@@ -69,28 +31,112 @@ def empty_blocks(volume, filt, transfer, *, block=8):
     Parameters
     ----------
     volume : Volume
-    filt : Filter or filter name
+    filt : Filter
     transfer : TransferFunction
     block : int
         Cells per block along each axis.
 
     Examples
     --------
-    >>> from vrlib import Volume, Glow
+    >>> from vrlib import Volume, Glow, make_filter
     >>> data = np.zeros((17, 17, 17)); data[12, 12, 12] = 1.0
-    >>> empty = empty_blocks(Volume(data), "trilinear", Glow(1.0), block=8)
+    >>> empty = empty_blocks(Volume(data), make_filter("trilinear"), Glow(1.0), block=8)
     >>> empty.shape, int(empty.sum())
     ((2, 2, 2), 7)
     """
-    filt = make_filter(filt)
-    pyr = volume.minmax_pyramid(block, margin=filter_margin(filt))
-    s_min, s_max, a_max = lattice_sums(filt)
-    lo, hi = pyr.minimum[0].astype(np.float64), pyr.maximum[0].astype(np.float64)
-    centre, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
-    reach = a_max * half
-    low = np.minimum(centre * s_min, centre * s_max) - reach
-    high = np.maximum(centre * s_min, centre * s_max) + reach
+    pyr = volume.minmax_pyramid(block, margin=filt.margin)
+    low, high = value_bounds(pyr.minimum[0].astype(np.float64),
+                             pyr.maximum[0].astype(np.float64), filt)
     return np.asarray(transfer.max_density(low, high)) <= 0.0
+
+
+def brick_empty_blocks(data, first, lo, hi, cells, filt, transfer, *, block=BLOCK):
+    """:func:`empty_blocks` for one brick of a volume, on the whole volume's block grid.
+
+    ``data`` holds the samples from global index ``first`` (z, y, x) on, covering the cells
+    ``[lo, hi)`` of a volume of ``cells`` cells plus the filter's margin. A block is marked
+    empty when nothing in its part of the brick can show; blocks outside the brick are marked
+    empty, since the brick takes no samples there.
+
+    Examples
+    --------
+    >>> from vrlib import Glow, make_filter
+    >>> data = np.zeros((9, 9, 17)); data[4, 4, 12] = 1.0       # cells [0, 8) x [0, 16)
+    >>> brick_empty_blocks(data, (0, 0, 0), (0, 0, 8), (8, 8, 16), (16, 16, 16),
+    ...                    make_filter("trilinear"), Glow(1.0))[0].tolist()
+    [[True, False], [True, True]]
+    """
+    empty = np.ones([-(-c // block) for c in cells], dtype=bool)
+    margin = filt.margin
+    b0 = [lo[a] // block for a in range(3)]
+    b1 = [-(-hi[a] // block) for a in range(3)]
+    for bz in range(b0[0], b1[0]):
+        for by in range(b0[1], b1[1]):
+            for bx in range(b0[2], b1[2]):
+                index = (bz, by, bx)
+                part = []
+                for a in range(3):
+                    c0 = max(index[a] * block, lo[a]) - margin
+                    c1 = min((index[a] + 1) * block, hi[a]) + 1 + margin
+                    part.append(slice(max(c0 - first[a], 0), max(c1 - first[a], 0)))
+                values = data[tuple(part)]
+                low, high = value_bounds(float(values.min()), float(values.max()), filt)
+                empty[index] = transfer.max_density(low, high) <= 0.0
+    return empty
+
+
+def coarsen(empty, factor=4):
+    """Blocks of ``factor^3`` blocks that are all empty (edge blocks padded as empty).
+
+    Examples
+    --------
+    >>> coarsen(np.ones((5, 4, 4), dtype=bool)).shape
+    (2, 1, 1)
+    """
+    pad = [(0, -n % factor) for n in empty.shape]
+    padded = np.pad(empty, pad, constant_values=True)
+    shape = []
+    for n in padded.shape:
+        shape += [n // factor, factor]
+    return padded.reshape(shape).all(axis=(1, 3, 5))
+
+
+def visible_box(volume, empty, block, lo, hi):
+    """World box around every non-empty block (a sliver larger, so that samples on its faces
+    are taken whatever the rounding), clipped to ``[lo, hi]``; empty if nothing is visible."""
+    full = np.argwhere(~empty)
+    if full.size == 0:
+        return lo, lo.copy()  # t_out <= t_in for every ray
+    first = full.min(axis=0)[::-1] * block  # cells, x y z
+    last = (full.max(axis=0)[::-1] + 1) * block
+    sliver = 1e-9 * (hi - lo)
+    box_lo = np.maximum(volume.origin + first * volume.spacing - sliver, lo)
+    box_hi = np.minimum(volume.origin + last * volume.spacing + sliver, hi)
+    return box_lo, box_hi
+
+
+def footprint_mask(view, lattice, empty, block):
+    """Pixels whose rays can meet a non-empty block: the union of the blocks' projected
+    bounding rectangles, one pixel wider all round (exact when conservative: a ray outside it
+    crosses only empty blocks, whose samples add nothing). ``lattice`` is anything with the
+    volume's sample ``shape``, ``origin`` and ``spacing`` (a :class:`vrlib.Volume`)."""
+    full = np.argwhere(~empty)[:, ::-1]  # block indices, x y z
+    corners = np.array(np.meshgrid([0, 1], [0, 1], [0, 1], indexing="ij")).reshape(3, -1).T
+    cells = (full[:, None, :] + corners[None, :, :]) * block
+    cells = np.minimum(cells, np.array(lattice.shape[::-1]) - 1)
+    projected = view.project(lattice.origin + cells * lattice.spacing)  # (blocks, 8, 3)
+    if not np.all(np.isfinite(projected)) or np.any(projected[..., 2] <= 0.0):
+        return np.ones(view.shape, dtype=bool)  # a block reaches behind the eye: keep all
+    r0 = np.clip(np.floor(projected[..., 0].min(axis=1)).astype(int) - 1, 0, view.height)
+    r1 = np.clip(np.floor(projected[..., 0].max(axis=1)).astype(int) + 2, 0, view.height)
+    c0 = np.clip(np.floor(projected[..., 1].min(axis=1)).astype(int) - 1, 0, view.width)
+    c1 = np.clip(np.floor(projected[..., 1].max(axis=1)).astype(int) + 2, 0, view.width)
+    marks = np.zeros((view.height + 1, view.width + 1), dtype=np.int64)
+    np.add.at(marks, (r0, c0), 1)
+    np.add.at(marks, (r0, c1), -1)
+    np.add.at(marks, (r1, c0), -1)
+    np.add.at(marks, (r1, c1), 1)
+    return marks.cumsum(axis=0).cumsum(axis=1)[:-1, :-1] > 0
 
 
 _RUNS_KEPT = 8  # run tables cached per volume (one per slicing axis and transfer function)
@@ -117,16 +163,13 @@ def transparent_runs(volume, axis, bound):
     n_k, n_j, n_i = slab.shape
     if bound < float(volume.value_range[0]):
         return np.zeros((n_k, n_j), np.int64), np.full((n_k, n_j), n_i - 1, np.int64)
-    key = ("runs", axis, float(bound))
-    derived = volume._derived
-    if key not in derived:
+
+    def runs():
         marks = slab > bound
         seen = marks.any(axis=2)
         first = np.where(seen, marks.argmax(axis=2), n_i).astype(np.int64)
         last = np.where(seen, n_i - 1 - marks[:, :, ::-1].argmax(axis=2), -1).astype(np.int64)
         first.flags.writeable = last.flags.writeable = False
-        kept = [k for k in derived if k[0] == "runs"]
-        for old in kept[: max(0, len(kept) - _RUNS_KEPT + 1)]:
-            del derived[old]
-        derived[key] = (first, last)
-    return derived[key]
+        return first, last
+
+    return volume.cached(("runs", axis, float(bound)), runs, keep=_RUNS_KEPT)

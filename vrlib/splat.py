@@ -24,38 +24,18 @@ import numpy as np
 from vrlib import _validate
 from vrlib._kernels import splat as _kernel
 from vrlib._scheduling import balanced_order
+from vrlib.arguments import refuse_shading
 from vrlib.footprint import RADIAL, footprint
 from vrlib.image import Image, RenderStats
-from vrlib.raycast import reconstructed_range
+from vrlib.value_bounds import reconstructed_range
+from vrlib.view import principal_axis
 
-__all__ = ["render_splat", "MODES", "major_axis"]
+__all__ = ["render_splat", "MODES"]
 
 #: Compositing modes of the splatter.
 MODES = ("sheet", "direct")
 #: Image rows per parallel task.
 BAND = 16
-#: Largest filter radius (voxels) the splatter takes, as for the ray caster.
-MAX_RADIUS = 4.0
-
-
-def major_axis(volume, view):
-    """The volume axis (0, 1, 2 for x, y, z) most parallel to the view, and whether slices run
-    front to back in increasing index order.
-
-    Orthographic views use the view direction; perspective views the direction from the eye to
-    the volume's centre. Ties (views at exactly 45 degrees) go to the lower axis.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> from vrlib import View, Volume
-    >>> major_axis(Volume(np.zeros((2, 2, 2))), View.orbit(azimuth=45, elevation=0))
-    (0, False)
-    """
-    direction = view.forward if view.eye is None else volume.center - view.eye
-    strength = np.abs(direction)
-    axis = int(np.flatnonzero(strength >= strength.max() - 1e-12)[0])
-    return axis, bool(direction[axis] > 0)
 
 
 def _slice_order(array, axis):
@@ -123,15 +103,10 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
         Footprint table entries per axis (:func:`vrlib.footprint.footprint`).
     """
     _validate.choice("mode", mode, MODES)
-    if filt.radius > MAX_RADIUS:
-        raise ValueError(f"filter radius {filt.radius:g} is out of range: splatting takes radii "
-                         f"up to {MAX_RADIUS} voxels")
-    if transfer.shading is not None:
-        raise ValueError("splatting does not shade (it reconstructs no gradients); "
-                         "use method='raycast' for shaded images")
-    axis, ascending = major_axis(volume, view)
+    refuse_shading(transfer, "splatting")
+    axis, ascending = principal_axis(view, volume)
     extent = volume.extent
-    if view.eye is not None and extent[axis, 0] <= view.eye[axis] <= extent[axis, 1]:
+    if view.is_perspective and extent[axis, 0] <= view.eye[axis] <= extent[axis, 1]:
         raise ValueError("splatting needs the eye outside the volume's slab along its major "
                          f"axis ({'xyz'[axis]}); move the eye out or use method='raycast'")
     spacing = volume.spacing
@@ -140,10 +115,11 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
     fp = radial or footprint(filt, spacing, view.basis, resolution=footprint_resolution)
     corners = np.array(np.meshgrid(*extent, indexing="ij")).reshape(3, -1).T
     depth = view.to_camera(corners)[:, 2].min()
-    if view.eye is not None and depth <= 0.0:
+    if view.is_perspective and depth <= 0.0:
         raise ValueError("part of the volume lies behind the eye: splatting cannot draw it; "
                          "move the eye back or use method='raycast'")
-    pixel_depth = view.pixel_size if view.eye is None else view.pixel_size / view.distance * depth
+    pixel_depth = view.pixel_size / view.distance * depth if view.is_perspective else \
+        view.pixel_size
     reach_max = max(fp.extent, fp.extent_v) / pixel_depth
     # Values a sheet can hold lie within the reconstruction's bounds; widen them generously
     # (the tables are exact inside and clamp outside).

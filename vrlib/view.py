@@ -19,8 +19,9 @@ import math
 import numpy as np
 
 from vrlib import _validate
+from vrlib._kernels import camera as _camera
 
-__all__ = ["View", "PROJECTIONS"]
+__all__ = ["View", "PROJECTIONS", "principal_axis"]
 
 #: Projections accepted by :class:`View`.
 PROJECTIONS = ("orthographic", "perspective")
@@ -190,6 +191,21 @@ class View:
         return self.projection == "perspective"
 
     @property
+    def start(self):
+        """Where rays start: the eye (perspective), or the centre of the origin plane,
+        ``radius`` before ``center`` along ``forward`` (orthographic), from which each ray is
+        offset by its pixel's position on the plane.
+
+        Examples
+        --------
+        >>> View([0, 0, -1], up=[0, 1, 0], radius=1.0).start.tolist()
+        [0.0, 0.0, 1.0]
+        """
+        if self.is_perspective:
+            return self.eye
+        return self.center - self.radius * self.forward
+
+    @property
     def eye(self):
         """Eye position (perspective) or ``None`` (orthographic: the eye is at infinity)."""
         if self.distance is None:
@@ -202,6 +218,12 @@ class View:
         (perspective)."""
         return self._pixel_size
 
+    @property
+    def plane_pixel(self):
+        """Pixel width on the image plane (orthographic), or at unit distance from the eye
+        (perspective): the pitch of the pixels' offsets from :attr:`start`."""
+        return self._pixel
+
     def _plane_offsets(self):
         """Offsets of pixel centres along ``right`` (per column) and ``up`` (per row)."""
         cols = (np.arange(self.width) + 0.5 - 0.5 * self.width) * self._pixel
@@ -209,18 +231,27 @@ class View:
         return rows, cols
 
     def packed(self):
-        """The view as 15 numbers for the numba kernels: centre, right, up, forward (3 each),
-        pixel width on the image plane (orthographic) or at unit distance (perspective),
-        radius, and the eye distance (0 for orthographic).
+        """The view as numbers for the numba kernels, laid out as the named offsets of
+        :mod:`vrlib._kernels.camera` say: centre, right, up, forward (3 each), pixel width on
+        the image plane (orthographic) or at unit distance (perspective), radius, and the eye
+        distance (0 for orthographic).
 
         Examples
         --------
-        >>> View([0, 0, -1], up=[0, 1, 0], size=2, radius=1.0).packed().tolist()[-3:]
+        >>> from vrlib._kernels.camera import DISTANCE, PIXEL, RADIUS
+        >>> camera = View([0, 0, -1], up=[0, 1, 0], size=2, radius=1.0).packed()
+        >>> camera[[PIXEL, RADIUS, DISTANCE]].tolist()
         [1.0, 1.0, 0.0]
         """
-        distance = 0.0 if self.distance is None else self.distance
-        return np.concatenate([self.center, self._basis.ravel(),
-                               [self._pixel, self.radius, distance]])
+        camera = np.empty(_camera.SIZE)
+        camera[_camera.CENTER:_camera.CENTER + 3] = self.center
+        camera[_camera.RIGHT:_camera.RIGHT + 3] = self.right
+        camera[_camera.UP:_camera.UP + 3] = self.up
+        camera[_camera.FORWARD:_camera.FORWARD + 3] = self.forward
+        camera[_camera.PIXEL] = self._pixel
+        camera[_camera.RADIUS] = self.radius
+        camera[_camera.DISTANCE] = self.distance if self.is_perspective else 0.0
+        return camera
 
     def rays(self):
         """One ray per pixel centre: ``(origins, directions)``, each ``(height, width, 3)``.
@@ -238,13 +269,13 @@ class View:
         rows, cols = self._plane_offsets()
         r, u, f = self._basis
         offsets = rows[:, None, None] * u + cols[None, :, None] * r
-        if self.distance is None:
-            origins = self.center - self.radius * f + offsets
+        if not self.is_perspective:
+            origins = self.start + offsets
             directions = np.broadcast_to(f, origins.shape).copy()
         else:
             directions = f + offsets
             directions /= np.linalg.norm(directions, axis=-1, keepdims=True)
-            origins = np.broadcast_to(self.eye, directions.shape).copy()
+            origins = np.broadcast_to(self.start, directions.shape).copy()
         return origins, directions
 
     def to_camera(self, points):
@@ -259,8 +290,7 @@ class View:
         [0.5, 0.25, 1.0]
         """
         p = np.asarray(points, dtype=np.float64)
-        start = self.center - self.radius * self.forward if self.eye is None else self.eye
-        return (p - start) @ self._basis.T
+        return (p - self.start) @ self._basis.T
 
     def project(self, points):
         """World points ``(..., 3)`` to continuous image coordinates ``(row, col, depth)``.
@@ -276,7 +306,7 @@ class View:
         """
         cam = self.to_camera(points)
         x, y, depth = cam[..., 0], cam[..., 1], cam[..., 2]
-        if self.distance is not None:
+        if self.is_perspective:
             with np.errstate(divide="ignore", invalid="ignore"):
                 scale = np.where(depth > 0.0, 1.0 / depth, np.nan)
             x, y = x * scale, y * scale
@@ -293,3 +323,23 @@ class View:
             f"View(forward=[{f}], size=({self.height}, {self.width}), "
             f"projection={self.projection!r}, zoom={self.zoom:g}{extra})"
         )
+
+
+def principal_axis(view, volume):
+    """The volume axis (0, 1, 2 for x, y, z) most parallel to the view, and whether slices
+    run front to back in increasing index order: the slicing axis of splatting and
+    shear-warp.
+
+    Orthographic views use the view direction; perspective views the direction from the eye
+    to the volume's centre. Ties (views at exactly 45 degrees) go to the lower axis.
+
+    Examples
+    --------
+    >>> from vrlib import Volume
+    >>> principal_axis(View.orbit(azimuth=45, elevation=0), Volume(np.zeros((2, 2, 2))))
+    (0, False)
+    """
+    direction = volume.center - view.eye if view.is_perspective else view.forward
+    strength = np.abs(direction)
+    axis = int(np.flatnonzero(strength >= strength.max() - 1e-12)[0])
+    return axis, bool(direction[axis] > 0)

@@ -14,7 +14,7 @@ from scipy import ndimage
 
 from vrlib import _validate
 
-__all__ = ["Volume", "MinMaxPyramid", "DEFAULT_EXTENT"]
+__all__ = ["Volume", "MinMaxPyramid", "DEFAULT_EXTENT", "check_extent"]
 
 #: The default world box, ``[[xmin, xmax], [ymin, ymax], [zmin, zmax]]``: the cube [-1, 1]^3.
 DEFAULT_EXTENT = ((-1.0, 1.0), (-1.0, 1.0), (-1.0, 1.0))
@@ -129,7 +129,7 @@ class Volume:
             arr = arr.view()
         arr.flags.writeable = False
         self._data = arr
-        self._extent = _check_extent(DEFAULT_EXTENT if extent is None else extent)
+        self._extent = check_extent(DEFAULT_EXTENT if extent is None else extent)
         self._derived = {}  # cached structures built from the samples (pyramids, runs)
         self._range = None
 
@@ -232,10 +232,8 @@ class Volume:
         """
         block = _validate.positive_int("block", block)
         margin = _validate.positive_int("margin", margin, minimum=0)
-        key = ("pyramid", block, margin)
-        if key not in self._derived:
-            self._derived[key] = _build_pyramid(self._data, block, margin)
-        return self._derived[key]
+        return self.cached(("pyramid", block, margin),
+                           lambda: _build_pyramid(self._data, block, margin))
 
     def slices(self, axis):
         """The samples as a stack of slices along ``axis`` (0, 1, 2 for x, y, z), indexed
@@ -259,11 +257,45 @@ class Volume:
             return self._data
         if axis == 1:
             return self._data.transpose(1, 0, 2)
-        key = ("slices", 0)
-        if key not in self._derived:
+
+        def transposed():
             copy = np.ascontiguousarray(self._data.transpose(2, 0, 1))
             copy.flags.writeable = False
-            self._derived[key] = copy
+            return copy
+
+        return self.cached(("slices", 0), transposed)
+
+    # -- structures derived from the samples -------------------------------------------------
+
+    def cached(self, key, build, *, keep=None):
+        """What ``build()`` makes from the samples, built on first use and kept with the
+        volume (its samples are read-only, so it never goes stale): pyramids, run tables,
+        transposed copies, prefiltered coefficients.
+
+        Parameters
+        ----------
+        key : tuple
+            Names the structure; its first entry is the structure's kind, e.g.
+            ``("pyramid", block, margin)``.
+        build : callable
+            Called with no arguments when ``key`` is not cached yet.
+        keep : int, optional
+            Keep at most this many structures of this kind (``key[0]``), dropping the oldest.
+
+        Examples
+        --------
+        >>> vol = Volume(np.arange(8.0).reshape(2, 2, 2))
+        >>> vol.cached(("total",), lambda: float(vol.data.sum()))
+        28.0
+        >>> vol.cached(("total",), lambda: 0.0)                  # built once
+        28.0
+        """
+        if key not in self._derived:
+            if keep is not None:
+                kind = [k for k in self._derived if k[0] == key[0]]
+                for old in kind[: max(0, len(kind) - keep + 1)]:
+                    del self._derived[old]
+            self._derived[key] = build()
         return self._derived[key]
 
     @classmethod
@@ -339,7 +371,19 @@ class Volume:
         return f"Volume(shape={self.shape}, dtype={self.dtype}, extent=[{ext}])"
 
 
-def _check_extent(extent):
+def check_extent(extent):
+    """``extent`` as a read-only float64 ``(3, 2)`` array of ``[min, max]`` per axis (x, y, z),
+    after checking it is finite and not empty or inverted along any axis.
+
+    Examples
+    --------
+    >>> check_extent([[0, 1], [0, 2], [-1, 1]]).tolist()
+    [[0.0, 1.0], [0.0, 2.0], [-1.0, 1.0]]
+    >>> check_extent([[0, 1], [0, 1], [1, 1]])
+    Traceback (most recent call last):
+    ...
+    ValueError: extent along z is empty: [1, 1]; it needs zmin < zmax
+    """
     try:
         ext = np.array(extent, dtype=np.float64)
     except (TypeError, ValueError):

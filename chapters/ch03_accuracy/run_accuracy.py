@@ -12,8 +12,8 @@ import data_gen
 import vrlib
 from chapters.common import atomic_path, by_profile, progress, result_path, write_json
 
-METHODS = ["raycast", "splat", "shear3", "shear2", "shearwarp"]
-FILTERS = ["box", "pyramid", "gaussian", "catmull-rom", "mitchell", "bspline"]
+METHODS = list(vrlib.METHODS)
+FILTERS = list(vrlib.filters.STANDARD)
 # Each field with the glow scale that keeps its brightest pixel's optical depth near 1-2, so
 # that images are neither faint nor saturated.
 FIELDS = {

@@ -4,12 +4,12 @@ reconstructed point and per frame), and run time against error with the Pareto f
 import matplotlib.pyplot as plt
 import numpy as np
 
+import vrlib
 from chapters.ch04_cost import _merged
 from chapters.common import figure_path, read_json, result_path, save_figure
 
-COLOURS = {"raycast": "C0", "splat": "C1", "shear3": "C2", "shear2": "C3", "shearwarp": "C4"}
-MARKERS = {"box": "s", "pyramid": "o", "gaussian": "v", "catmull-rom": "*", "mitchell": "P",
-           "bspline": "D"}
+COLOURS = {method: f"C{i}" for i, method in enumerate(vrlib.METHODS)}
+MARKERS = dict(zip(vrlib.filters.STANDARD, "sov*PD^<>hX", strict=False))
 
 
 def model_fit():

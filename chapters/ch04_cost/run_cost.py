@@ -16,23 +16,18 @@ from chapters.ch04_cost import _scenes
 from chapters.common import ROOT, by_profile, progress, result_path, write_json
 from vrlib.cost import machine, measure, points
 
-METHODS = ["raycast", "splat", "shear3", "shear2", "shearwarp"]
+METHODS = list(vrlib.METHODS)
 FILTERS = ["pyramid", "gaussian", "catmull-rom"]
 N, SIZE = by_profile(64, 128), by_profile(128, 256)
 TWIN_N, TWIN_SIZE = 10, 12
 
 
 def twins():
+    """The naive NumPy twins of the renderers (``tests/naive.py``), by method."""
     sys.path.insert(0, str(ROOT / "tests"))
     import naive
 
-    return {
-        "raycast": lambda v, w, f, t: naive.raycast_naive(v, w, f, t, 0.5),
-        "splat": lambda v, w, f, t: naive.splat_naive(v, w, f, t, "sheet"),
-        "shear3": lambda v, w, f, t: naive.shear_naive(v, w, f, t, 0.5, 3),
-        "shear2": lambda v, w, f, t: naive.shear_naive(v, w, f, t, 0.5, 2),
-        "shearwarp": lambda v, w, f, t: naive.shearwarp_naive(v, w, f, t),
-    }
+    return naive.TWINS
 
 
 def main():
@@ -63,7 +58,7 @@ def main():
                     seconds, image = measure(partial(draw, threads))
                     runs.append((label, seconds, image.stats))
             for label, seconds, stats in runs:
-                count = points(method, stats)
+                count = points(stats)
                 record["rows"].append({
                     "scene": scene, "method": method, "filter": filt, "backend": label,
                     "n": n, "size": size, "seconds": seconds, "points": count,

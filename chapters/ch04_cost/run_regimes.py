@@ -36,7 +36,7 @@ def main():
                                      method=method: vrlib.render(
                                          volume, view, method=method, filter="pyramid",
                                          transfer=transfer, step=1.0))
-            count = points(method, image.stats)
+            count = points(image.stats)
             rows.append({"scene": scene, "m": m, "method": method, "seconds": seconds,
                          "points": count, "ns_per_point": 1e9 * seconds / max(count, 1),
                          "visible_fraction": _scenes.visible_fraction(volume, transfer)})

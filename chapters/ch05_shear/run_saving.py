@@ -8,8 +8,8 @@ arithmetic operations by the renderers' own count, wall time (best of two) and t
 NumPy memory during the render (tracemalloc). Writes ``build/results/ch05_shear/saving.json``.
 """
 
-import time
 import tracemalloc
+from functools import partial
 
 import numpy as np
 from tqdm import tqdm
@@ -17,18 +17,15 @@ from tqdm import tqdm
 import data_gen
 import vrlib
 from chapters.common import by_profile, result_path, write_json
+from vrlib.cost import measure
 
 N = by_profile(128, 256)
 ROTATIONS = by_profile(50, 200)
 
 
-def measure(volume, view, method):
-    best = None
-    for _ in range(2):
-        start = time.perf_counter()
-        img = vrlib.render(volume, view, method=method, filter="catmull-rom", step=1.0)
-        seconds = time.perf_counter() - start
-        best = seconds if best is None else min(best, seconds)
+def measure_pass(volume, view, method):
+    best, img = measure(partial(vrlib.render, volume, view, method=method,
+                                filter="catmull-rom", step=1.0), repeats=2, warmup=False)
     tracemalloc.start()
     vrlib.render(volume, view, method=method, filter="catmull-rom", step=1.0)
     peak = tracemalloc.get_traced_memory()[1]
@@ -52,8 +49,8 @@ def main():
                                    desc="rotations", disable=None):
         view = vrlib.View.orbit(azimuth=azimuth, elevation=elevation, size=size)
         rows.append({"azimuth": float(azimuth), "elevation": float(elevation),
-                     "shear3": measure(volume, view, "shear3"),
-                     "shear2": measure(volume, view, "shear2")})
+                     "shear3": measure_pass(volume, view, "shear3"),
+                     "shear2": measure_pass(volume, view, "shear2")})
     write_json(result_path(__file__, "saving.json"),
                {"N": N, "image": size, "rotations": rows, "volume_bytes": int(volume.data.nbytes)})
 

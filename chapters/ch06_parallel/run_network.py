@@ -18,6 +18,7 @@ import numpy as np
 from chapters.common import by_profile, progress, result_path, write_json
 from vrlib import View
 from vrlib.parallel import decompose, model, network, traffic
+from vrlib.parallel.composite import COMPOSITORS
 
 NODES = by_profile([4, 16, 64, 256, 1024, 4096], [4, 16, 64, 256, 1024, 4096])
 VOXELS_PER_NODE = by_profile(32**3, 64**3)
@@ -56,16 +57,17 @@ def frame(name, nodes, n, angles, tiles):
         grid = decompose.grid_shape(parts, shape)
         tree = decompose.split(cells, parts, grid=grid)
         owners = decompose.interleaved_owners(parts, nodes)
-        msgs, _ = traffic.object_fragments(tree, owners, tiles, view, origin, spacing,
-                                           bytes_per_pixel=PIXEL_BYTES)
+        msgs = COMPOSITORS["direct-send"].messages(tree, owners, tiles, view, origin, spacing,
+                                                   bytes_per_pixel=PIXEL_BYTES)
         cauchy = model.object_frame(grid, side=2.0, pixel=pixel, bytes_per_pixel=PIXEL_BYTES)
         exact = model.object_frame(grid, side=2.0, pixel=pixel, bytes_per_pixel=PIXEL_BYTES,
                                    view=view)
         return msgs, cauchy[1], exact[1]
     if name in ("object blocks binary swap", "binary swap full screen"):
         tree = decompose.split(cells, nodes)
-        msgs = traffic.binary_swap(tree, view, origin, spacing, bytes_per_pixel=PIXEL_BYTES,
-                                   bounded=name.startswith("object"))
+        msgs = COMPOSITORS["binary-swap"].messages(tree, np.arange(nodes), tiles, view, origin,
+                                                   spacing, bytes_per_pixel=PIXEL_BYTES,
+                                                   bounded=name.startswith("object"))
         classic = model.binary_swap_frame(nodes, WIDTH, WIDTH, bytes_per_pixel=PIXEL_BYTES)[1]
         return msgs, classic, classic
     tile = WIDTH / math.sqrt(nodes)

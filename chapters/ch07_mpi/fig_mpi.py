@@ -5,14 +5,15 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from chapters.common import figure_path, read_json, result_path, save_figure
+from vrlib.parallel.composite import COMPOSITORS
 
 
 def main():
     data = read_json(result_path(__file__, "mpi.json"))
     fig, (left, middle, right) = plt.subplots(1, 3, figsize=(15, 4.3))
-    for key, marker, label in (("binary-swap", "o", "binary swap"),
-                               ("direct-send", "s", "direct send"),
-                               ("image", "^", "image partition (voxels)")):
+    series = [(name, name.replace("-", " ")) for name in COMPOSITORS]
+    series.append(("image", "image partition (voxels)"))
+    for (key, label), marker in zip(series, "os^Dv<>", strict=False):
         sim, meas = [], []
         for e in data["equality"]:
             case = next(c for c in e["cases"] if c["compositing"] == key
@@ -47,7 +48,8 @@ def main():
     p = [r["ranks"] for r in rows]
     right.loglog(p, [r["frame_s"] for r in rows], "-o", label="model frame time")
     right.loglog(p, [r["composite_s"] for r in rows], "--", label="model compositing")
-    measured = [(t["ranks"], t["cases"][0]["seconds"]) for t in data["timing"]]
+    measured = [(t["ranks"], c["seconds"]) for t in data["timing"] for c in t["cases"]
+                if c["compositing"] == "binary-swap"]
     right.loglog(*zip(*measured, strict=True), "kD", ms=7, label="measured (binary swap)")
     right.set_xlabel("ranks")
     right.set_ylabel("seconds per frame")

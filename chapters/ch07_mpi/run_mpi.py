@@ -20,14 +20,16 @@ import data_gen
 from chapters.common import ROOT, by_profile, progress, result_path, write_json
 from vrlib import View
 from vrlib.parallel import decompose, traffic
+from vrlib.parallel.composite import COMPOSITORS
 
 MPIEXEC = Path(sys.executable).parent / "mpiexec"
 DENSE = {"field": "marschner-lobb", "params": {}}
 SPARSE = {"field": "random-blobs", "params": {"count": 6, "seed": 7}}
 ORBIT = {"azimuth": 35.0, "elevation": 25.0}
 RAMP = {"threshold": 0.25, "scale": 8.0}
-ALL_CASES = [["binary-swap", "even"], ["direct-send", "even"], ["direct-send", "interleaved"],
-             ["binary-swap", "work"], ["image", None]]
+# Every compositor with even bricks, then the other balances and the image partition.
+ALL_CASES = [[name, "even"] for name in COMPOSITORS] + [
+    ["direct-send", "interleaved"], ["binary-swap", "work"], ["image", None]]
 EQUALITY = {"n": by_profile(49, 97), "size": by_profile(96, 192)}
 BALANCE = {"n": by_profile(65, 129), "size": by_profile(128, 256), "ranks": [4, 8]}
 TIMING = {"n": by_profile(129, 257), "size": by_profile(256, 512), "repeats": 3}
@@ -52,14 +54,13 @@ def simulated_bytes(ranks, n, size):
     origin, spacing = np.array([-1.0, -1.0, -1.0]), np.full(3, 2.0 / (n - 1))
     tree = decompose.split((n - 1,) * 3, ranks)
     tiles = decompose.screen_tiles(size, size, ranks)
-    direct, _ = traffic.object_fragments(tree, np.arange(ranks), tiles, view, origin, spacing,
-                                         bytes_per_pixel=PIXEL_BYTES)
-    swap = traffic.binary_swap(tree, view, origin, spacing, bytes_per_pixel=PIXEL_BYTES)
-    image = traffic.image_static(tree, np.arange(ranks), tiles, view, (n,) * 3, origin,
-                                 spacing, radius=1.0, bytes_per_voxel=8)
-    return {"direct-send": direct.sent_per_node(ranks).tolist(),
-            "binary-swap": swap.sent_per_node(ranks).tolist(),
-            "image": image.sent_per_node(ranks).tolist()}
+    owners = np.arange(ranks)
+    sent = {name: compositor.messages(tree, owners, tiles, view, origin, spacing,
+                                      bytes_per_pixel=PIXEL_BYTES).sent_per_node(ranks).tolist()
+            for name, compositor in COMPOSITORS.items()}
+    image = traffic.image_static(tree, owners, tiles, view, (n,) * 3, origin, spacing,
+                                 radius=1.0, bytes_per_voxel=8)
+    return {**sent, "image": image.sent_per_node(ranks).tolist()}
 
 
 def main():
@@ -84,7 +85,7 @@ def main():
     for ranks in progress([1, 2], "timing"):
         report = launch(ranks, {**DENSE, **RAMP, "n": TIMING["n"], "size": TIMING["size"],
                                 "orbit": ORBIT, "repeats": TIMING["repeats"],
-                                "cases": [["binary-swap", "even"], ["direct-send", "even"]]})
+                                "cases": [[name, "even"] for name in COMPOSITORS]})
         timing.append({"ranks": ranks, "cases": report["cases"]})
     prediction = predict(timing)
     write_json(result_path(__file__, "mpi.json"), {
@@ -100,7 +101,7 @@ def summarise(equality, balance, timing, prediction):
     worst = max(c["difference"] for e in equality for c in e["cases"])
     ratios = []
     for e in equality[1:]:
-        for key in ("direct-send", "binary-swap"):
+        for key in COMPOSITORS:
             case = next(c for c in e["cases"] if c["compositing"] == key
                         and c["balance"] == "even")
             sent = np.array([r["bytes"]["composite"] for r in case["ranks"]], dtype=float)
@@ -116,7 +117,7 @@ def summarise(equality, balance, timing, prediction):
     for name, scene in (("dense", DENSE), ("sparse", SPARSE)):
         samples = data_gen.make_field(scene["field"], **scene["params"]).sample(BALANCE["n"])
         visible[name] = float((samples.data > RAMP["threshold"]).mean())
-    t1, t2 = timing[0]["cases"][0]["seconds"], timing[1]["cases"][0]["seconds"]
+    t1, t2 = (_swap(t)["seconds"] for t in timing)
     two = next(r for r in prediction["rows"] if r["ranks"] == 2)
     return {"max_difference": worst, "sent_over_simulated": [min(ratios), max(ratios)],
             "imbalance": imbalance, "t1": t1, "t2": t2, "speedup": t1 / t2,
@@ -124,13 +125,18 @@ def summarise(equality, balance, timing, prediction):
             "rate_mb_s": prediction["bytes_per_second"] / 1e6, "visible": visible}
 
 
+def _swap(run):
+    """The binary-swap case of a timing run (the case the speedup and the model quote)."""
+    return next(c for c in run["cases"] if c["compositing"] == "binary-swap")
+
+
 def predict(timing):
     """Frame time at larger P from the measured costs: the 1-rank frame (sampling the field,
     ray casting, everything but communication) divided evenly over P ranks, plus binary swap's
     bounded bytes for the busiest rank at that P (traffic module) at the compositing rate
     measured with 2 ranks (bytes sent over seconds spent compositing)."""
-    single = timing[0]["cases"][0]["seconds"]
-    two = timing[1]["cases"][0]["ranks"]
+    single = _swap(timing[0])["seconds"]
+    two = _swap(timing[1])["ranks"]
     moved = sum(r["bytes"]["composite"] for r in two)
     spent = sum(r["composite_s"] for r in two)
     rate = moved / spent if spent > 0 else math.inf
@@ -140,7 +146,8 @@ def predict(timing):
     rows = []
     for p in PREDICT:
         tree = decompose.split((n - 1,) * 3, p)
-        swap = traffic.binary_swap(tree, view, origin, spacing, bytes_per_pixel=PIXEL_BYTES)
+        swap = COMPOSITORS["binary-swap"].messages(tree, np.arange(p), None, view, origin,
+                                                   spacing, bytes_per_pixel=PIXEL_BYTES)
         busiest = float(swap.sent_per_node(p).max())
         work = single / p
         rows.append({"ranks": p, "work_s": work, "composite_s": busiest / rate,

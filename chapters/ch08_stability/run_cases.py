@@ -17,7 +17,7 @@ import vrlib
 from chapters.ch08_stability._exact import constant_image, glow_image
 from chapters.common import progress, result_path, write_json
 
-METHODS = ["raycast", "splat", "shear3", "shear2", "shearwarp"]
+METHODS = list(vrlib.METHODS)
 N, SIZE, SCALE = 32, 48, 2.0
 BLOB = data_gen.make_field("gaussian-blob", sigma=0.3, center=(0.05, -0.1, 0.08))
 CASES = []

@@ -15,7 +15,7 @@ from chapters.common import by_profile, progress, result_path, write_json
 
 STEPS = [4.0, 2.0, 1.0, 0.5, 0.25, 0.125, 0.0625]
 RESOLUTIONS = by_profile([12, 16, 24, 32, 48, 64], [16, 24, 32, 48, 64, 96, 128])
-METHODS = ["raycast", "splat", "shear3", "shear2", "shearwarp"]
+METHODS = list(vrlib.METHODS)
 FILTERS = ["trilinear", "catmull-rom", "bspline"]
 SCALE = 2.0
 

@@ -23,7 +23,7 @@ from vrlib.compositing import correct_opacity, segment_alpha
 
 DEPTHS = np.logspace(-10, 2, 241)
 SCALES = np.logspace(-6, 6, 13)
-METHODS = ["raycast", "splat", "shear3", "shear2", "shearwarp"]
+METHODS = list(vrlib.METHODS)
 
 
 def segment_models():

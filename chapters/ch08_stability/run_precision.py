@@ -21,7 +21,7 @@ LENGTHS = [16, 64, 256, 1024, 4096]
 ALPHAS = [1e-4, 1e-3, 1e-2]
 RAYS = by_profile(2000, 20000)
 SIZES = by_profile([32, 64, 128], [64, 128, 256])
-METHODS = ["raycast", "splat", "shear3", "shear2", "shearwarp"]
+METHODS = list(vrlib.METHODS)
 
 
 def accumulate(alpha, dtype, compensated=False):

@@ -1,8 +1,9 @@
 """Tables: every stress case with its verdict per method, and the precision of storage."""
 
+import vrlib
 from chapters.common import figure_path, read_json, result_path, write_csv
 
-METHODS = ["raycast", "splat", "shear3", "shear2", "shearwarp"]
+METHODS = list(vrlib.METHODS)
 
 
 def cell(result):

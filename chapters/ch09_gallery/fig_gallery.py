@@ -4,10 +4,11 @@ import imageio.v3 as iio
 import matplotlib.pyplot as plt
 import numpy as np
 
+import vrlib
 from chapters.common import figure_path, read_json, result_path, save_figure
-from vrlib._io import atomic_path
+from vrlib.atomic import atomic_path
 
-METHODS = ["raycast", "splat", "shear3", "shear2", "shearwarp"]
+METHODS = list(vrlib.METHODS)
 
 
 def main():

@@ -13,7 +13,7 @@ import numpy as np
 import data_gen
 import vrlib
 from chapters.common import by_profile, progress, result_path, write_json
-from vrlib._io import atomic_path
+from vrlib.atomic import atomic_path
 
 SIZE = by_profile(160, 320)
 FRAMES = by_profile(24, 72)
@@ -45,13 +45,7 @@ def main():
         view = vrlib.View.orbit(azimuth=120 if field is None else 30, elevation=15,
                                 size=SIZE, zoom=1.6 if field is None else 1.0,
                                 radius=volume.bounding_radius, center=volume.center)
-        if field is not None:
-            reference = vrlib.render_reference(field, view, transfer=transfer)
-            label = "reference renderer"
-        else:
-            reference = vrlib.render(volume, view, filter="catmull-rom", transfer=transfer,
-                                     step=0.125, early_termination=1.0)
-            label = "ray casting, step 1/8"
+        reference, label = vrlib.reference_image(volume, view, transfer=transfer, field=field)
         images[f"{name}/reference"] = reference.rgba
         errors[name] = {"reference": label}
         for method in vrlib.METHODS:

@@ -23,7 +23,7 @@ def per_point(method, filt, *, m=2.0, n=32):
     view = vrlib.View.orbit(azimuth=30, elevation=20, size=int(m * n))
     stats = vrlib.render(vol, view, method=method, filter=filt, step=0.5,
                          early_termination=1.0).stats
-    return stats.operations / points(method, stats), points(method, stats)
+    return stats.operations / points(stats), points(stats)
 
 
 @pytest.mark.claim(2, "supports")

@@ -22,6 +22,7 @@ import pytest
 
 from vrlib import View
 from vrlib.parallel import decompose, network, traffic
+from vrlib.parallel.composite import COMPOSITORS
 
 NODES = [16, 64, 256, 1024]
 WIDTH = 512
@@ -48,8 +49,8 @@ def one_frame(shape, nodes, view):
     else:
         grid = decompose.grid_shape(nodes, shape)
         tree = decompose.split((n - 1,) * 3, nodes, grid=grid)
-        msgs, _ = traffic.object_fragments(tree, np.arange(nodes), tiles, view, origin,
-                                           spacing)
+        msgs = COMPOSITORS["direct-send"].messages(tree, np.arange(nodes), tiles, view, origin,
+                                                   spacing)
     load = network.Network.square(nodes).route(msgs.src, msgs.dst, msgs.bytes)
     return {"total": msgs.total, "max": load.max, "mean": load.mean,
             "bisection": load.bisection()}

@@ -21,7 +21,8 @@ import pytest
 
 import data_gen
 from vrlib import LookupTransfer, View
-from vrlib.parallel import decompose, model, mpi, taxonomy, traffic
+from vrlib.parallel import decompose, model, mpi, taxonomy
+from vrlib.parallel.composite import COMPOSITORS
 
 RAMP = LookupTransfer(8.0 * np.clip((np.linspace(0, 1, 257) - 0.25) / 0.75, 0.0, 1.0))
 PROGRAM = Path(__file__).parent.parent / "mpi_programs" / "render.py"
@@ -61,8 +62,8 @@ def test_object_partition_costs_order_as_derived():
     for shape, per_node in (("slabs", 1), ("shafts", 1), ("blocks", 1), ("blocks", 8)):
         parts = nodes * per_node
         tree = decompose.split((n - 1,) * 3, parts, grid=decompose.grid_shape(parts, shape))
-        msgs, _ = traffic.object_fragments(tree, decompose.interleaved_owners(parts, nodes),
-                                           tiles, view, origin, spacing)
+        msgs = COMPOSITORS["direct-send"].messages(
+            tree, decompose.interleaved_owners(parts, nodes), tiles, view, origin, spacing)
         totals[(shape, per_node)] = msgs.total
     assert totals[("blocks", 1)] < totals[("shafts", 1)] < totals[("slabs", 1)]
     assert totals[("blocks", 8)] / totals[("blocks", 1)] == pytest.approx(2.0, rel=0.15)

@@ -1,7 +1,8 @@
 """1-D reconstruction-filter weights for use inside numba kernels.
 
 A filter reaches a kernel as plain scalars ``(kind, p0, p1, p2)`` (see
-:attr:`vrlib.filters.Filter.code`), so one compiled kernel serves every filter:
+:attr:`vrlib.filters.Filter.code`, which derives them from the filter's one definition in
+:mod:`vrlib.filters`), so one compiled kernel serves every filter:
 
 ============  ==========================================================
 kind          parameters
@@ -20,6 +21,31 @@ import math
 from vrlib._kernels._jit import jit
 
 BOX, TENT, GAUSSIAN, CUBIC = 0, 1, 2, 3
+#: Most taps per axis a kernel takes (scratch arrays hold this many): filter radii up to 4.
+MAX_TAPS = 8
+
+
+@jit
+def cubic_coefficients(b, c):
+    """The Mitchell-Netravali (B, C) kernel's two cubic pieces, times 6, in ascending powers of
+    ``|x|``: ``near`` on [0, 1) and ``far`` on [1, 2) (Mitchell and Netravali 1988). The one
+    definition of the family: :class:`vrlib.filters.MitchellNetravali` and every kernel read
+    it."""
+    near = (6.0 - 2.0 * b, 0.0, -18.0 + 12.0 * b + 6.0 * c, 12.0 - 9.0 * b - 6.0 * c)
+    far = (8.0 * b + 24.0 * c, -12.0 * b - 48.0 * c, 6.0 * b + 30.0 * c, -b - 6.0 * c)
+    return near, far
+
+
+@jit
+def cubic_piece(p, x):
+    """A cubic piece of :func:`cubic_coefficients` at ``x >= 0`` (still times 6)."""
+    return p[3] * x * x * x + p[2] * x * x + p[1] * x + p[0]
+
+
+@jit
+def cubic_piece_slope(p, x):
+    """The derivative of :func:`cubic_piece` at ``x`` (still times 6)."""
+    return 3.0 * p[3] * x * x + 2.0 * p[2] * x + p[1]
 
 
 @jit
@@ -29,21 +55,12 @@ def weight(kind, p0, p1, p2, x):
         ax = abs(x)
         return 1.0 - ax if ax < 1.0 else 0.0
     if kind == CUBIC:
-        b, c = p0, p1
+        near, far = cubic_coefficients(p0, p1)
         ax = abs(x)
         if ax < 1.0:
-            return (
-                (12.0 - 9.0 * b - 6.0 * c) * ax * ax * ax
-                + (-18.0 + 12.0 * b + 6.0 * c) * ax * ax
-                + (6.0 - 2.0 * b)
-            ) / 6.0
+            return cubic_piece(near, ax) / 6.0
         if ax < 2.0:
-            return (
-                (-b - 6.0 * c) * ax * ax * ax
-                + (6.0 * b + 30.0 * c) * ax * ax
-                + (-12.0 * b - 48.0 * c) * ax
-                + (8.0 * b + 24.0 * c)
-            ) / 6.0
+            return cubic_piece(far, ax) / 6.0
         return 0.0
     if kind == GAUSSIAN:
         if abs(x) < p1:
@@ -61,20 +78,13 @@ def derivative(kind, p0, p1, p2, x):
             return 0.0
         return -1.0 if x > 0.0 else 1.0
     if kind == CUBIC:
-        b, c = p0, p1
+        near, far = cubic_coefficients(p0, p1)
         ax = abs(x)
         sign = 1.0 if x >= 0.0 else -1.0
         if ax < 1.0:
-            return sign * (
-                3.0 * (12.0 - 9.0 * b - 6.0 * c) * ax * ax
-                + 2.0 * (-18.0 + 12.0 * b + 6.0 * c) * ax
-            ) / 6.0
+            return sign * cubic_piece_slope(near, ax) / 6.0
         if ax < 2.0:
-            return sign * (
-                3.0 * (-b - 6.0 * c) * ax * ax
-                + 2.0 * (6.0 * b + 30.0 * c) * ax
-                + (-12.0 * b - 48.0 * c)
-            ) / 6.0
+            return sign * cubic_piece_slope(far, ax) / 6.0
         return 0.0
     if kind == GAUSSIAN:
         if abs(x) < p1:

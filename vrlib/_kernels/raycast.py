@@ -18,58 +18,10 @@ import numpy as np
 from numba import prange
 
 from vrlib._kernels._jit import jit, parallel_jit
-from vrlib._kernels.filters import CUBIC, TENT
-from vrlib._kernels.sampling import (
-    MAX_TAPS,
-    gradient,
-    reconstruct,
-    separable4,
-    tricubic,
-    trilinear,
-)
-
-
-@jit
-def ray_box(o, d, lo, hi):
-    """Parameters ``(t_in, t_out)`` where the ray ``o + t d`` crosses the box ``[lo, hi]``
-    (``t_in >= t_out`` when it misses); ``o`` and ``d`` are 3-tuples."""
-    t_in = -math.inf
-    t_out = math.inf
-    for a in range(3):
-        if d[a] == 0.0:
-            if o[a] < lo[a] or o[a] > hi[a]:
-                return 0.0, 0.0
-        else:
-            ta = (lo[a] - o[a]) / d[a]
-            tb = (hi[a] - o[a]) / d[a]
-            if ta > tb:
-                ta, tb = tb, ta
-            t_in = max(t_in, ta)
-            t_out = min(t_out, tb)
-    return t_in, t_out
-
-
-@jit
-def pixel_ray(camera, height, width, r, c):
-    """Origin and unit direction of the ray through pixel ``(r, c)`` of a packed view
-    (:meth:`vrlib.View.packed`), as :meth:`vrlib.View.rays` computes them."""
-    px = camera[12]
-    x = (c + 0.5 - 0.5 * width) * px
-    y = (0.5 * height - r - 0.5) * px
-    fx, fy, fz = camera[9], camera[10], camera[11]
-    sx = y * camera[6] + x * camera[3]
-    sy = y * camera[7] + x * camera[4]
-    sz = y * camera[8] + x * camera[5]
-    distance = camera[14]
-    if distance == 0.0:
-        radius = camera[13]
-        o = (camera[0] - radius * fx + sx, camera[1] - radius * fy + sy,
-             camera[2] - radius * fz + sz)
-        return o, (fx, fy, fz)
-    dx, dy, dz = fx + sx, fy + sy, fz + sz
-    norm = math.sqrt(dx * dx + dy * dy + dz * dz)
-    o = (camera[0] - distance * fx, camera[1] - distance * fy, camera[2] - distance * fz)
-    return o, (dx / norm, dy / norm, dz / norm)
+from vrlib._kernels.camera import pixel_ray, ray_box
+from vrlib._kernels.filters import CUBIC, MAX_TAPS, TENT
+from vrlib._kernels.sampling import gradient, reconstruct, separable4, tricubic, trilinear
+from vrlib._kernels.tables import lookup
 
 
 @jit
@@ -101,17 +53,6 @@ def _exit(ax, ay, az, bx, by, bz, cells, counts, ux, uy, uz):
             edge = (block + 1) * cells if b > 0.0 else block * cells
             t_exit = min(t_exit, (edge - a) / b)
     return t_exit
-
-
-@jit
-def _lookup(x, n):
-    """Left table entry and weight for grid position ``x`` (clamped to the table)."""
-    if not x > 0.0:  # also catches NaN
-        return 0, 0.0
-    if x >= n - 1:
-        return n - 2, 1.0
-    i = int(x)
-    return i, x - i
 
 
 @parallel_jit
@@ -230,7 +171,7 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, camera, heigh
                 k += 1
                 # Classify: segment opacity 1 - exp(-density ds) (eq 1.4) and colour E alpha
                 # (eq 1.9), from the table.
-                i, w = _lookup((value - tstart) * tinv, ntab)
+                i, w = lookup((value - tstart) * tinv, ntab)
                 alpha = alpha_tab[i] + w * (alpha_tab[i + 1] - alpha_tab[i])
                 if not alpha > 0.0:
                     continue  # a transparent segment adds exactly nothing

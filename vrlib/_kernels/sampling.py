@@ -12,14 +12,18 @@ from __future__ import annotations
 import math
 
 from vrlib._kernels._jit import jit
-from vrlib._kernels.filters import GAUSSIAN, derivative, weight
-
-#: Largest number of taps per axis (a filter radius of at most 4 voxels).
-MAX_TAPS = 8
+from vrlib._kernels.filters import (
+    GAUSSIAN,
+    cubic_coefficients,
+    cubic_piece,
+    derivative,
+    weight,
+)
 
 
 @jit
-def _clamp(i, n):
+def clamp(i, n):
+    """Index ``i`` clamped to ``[0, n - 1]`` (the volume extended by its border values)."""
     if i < 0:
         return 0
     if i > n - 1:
@@ -52,12 +56,12 @@ def reconstruct(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1, fp2, radius, 
     fz = _taps(fkind, fp0, fp1, fp2, radius, ntaps, uz, wz)
     value = 0.0
     for c in range(ntaps):
-        kz = _clamp(fz + c, gshape[0]) - offset[0]
+        kz = clamp(fz + c, gshape[0]) - offset[0]
         for b in range(ntaps):
-            ky = _clamp(fy + b, gshape[1]) - offset[1]
+            ky = clamp(fy + b, gshape[1]) - offset[1]
             row = 0.0
             for a in range(ntaps):
-                row += wx[a] * data[kz, ky, _clamp(fx + a, gshape[2]) - offset[2]]
+                row += wx[a] * data[kz, ky, clamp(fx + a, gshape[2]) - offset[2]]
             value += wz[c] * wy[b] * row
     return value
 
@@ -86,12 +90,12 @@ def trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz):
         d110 = flat[base + nxy + nx]
         d111 = flat[base + nxy + nx + 1]
     else:
-        x0 = _clamp(ix, gx) - ox
-        x1 = _clamp(ix + 1, gx) - ox
-        y0 = (_clamp(iy, gy) - oy) * nx
-        y1 = (_clamp(iy + 1, gy) - oy) * nx
-        z0 = (_clamp(iz, gz) - oz) * nxy
-        z1 = (_clamp(iz + 1, gz) - oz) * nxy
+        x0 = clamp(ix, gx) - ox
+        x1 = clamp(ix + 1, gx) - ox
+        y0 = (clamp(iy, gy) - oy) * nx
+        y1 = (clamp(iy + 1, gy) - oy) * nx
+        z0 = (clamp(iz, gz) - oz) * nxy
+        z1 = (clamp(iz + 1, gz) - oz) * nxy
         d000 = flat[z0 + y0 + x0]
         d001 = flat[z0 + y0 + x1]
         d010 = flat[z0 + y1 + x0]
@@ -113,16 +117,9 @@ def trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz):
 def _cubic_weights(t, b, c):
     """Mitchell-Netravali weights of the taps at offsets -1, 0, 1, 2 from a point at fraction
     ``t`` in [0, 1) past tap 0 (distances 1 + t, t, 1 - t, 2 - t)."""
-    u = 1.0 + t
-    w0 = ((-b - 6 * c) * u * u * u + (6 * b + 30 * c) * u * u + (-12 * b - 48 * c) * u
-          + (8 * b + 24 * c)) / 6.0
-    w1 = ((12 - 9 * b - 6 * c) * t * t * t + (-18 + 12 * b + 6 * c) * t * t + (6 - 2 * b)) / 6.0
-    v = 1.0 - t
-    w2 = ((12 - 9 * b - 6 * c) * v * v * v + (-18 + 12 * b + 6 * c) * v * v + (6 - 2 * b)) / 6.0
-    u = 2.0 - t
-    w3 = ((-b - 6 * c) * u * u * u + (6 * b + 30 * c) * u * u + (-12 * b - 48 * c) * u
-          + (8 * b + 24 * c)) / 6.0
-    return w0, w1, w2, w3
+    near, far = cubic_coefficients(b, c)
+    return (cubic_piece(far, 1.0 + t) / 6.0, cubic_piece(near, t) / 6.0,
+            cubic_piece(near, 1.0 - t) / 6.0, cubic_piece(far, 2.0 - t) / 6.0)
 
 
 @jit
@@ -188,15 +185,15 @@ def four_taps(flat, nx, nxy, oz, oy, ox, gz, gy, gx, fx, fy, fz, wx, wy, wz):
                                    + wx[2] * flat[row + 2] + wx[3] * flat[row + 3])
             value += wz[cz] * plane
         return value
-    x0 = _clamp(fx, gx) - ox
-    x1 = _clamp(fx + 1, gx) - ox
-    x2 = _clamp(fx + 2, gx) - ox
-    x3 = _clamp(fx + 3, gx) - ox
+    x0 = clamp(fx, gx) - ox
+    x1 = clamp(fx + 1, gx) - ox
+    x2 = clamp(fx + 2, gx) - ox
+    x3 = clamp(fx + 3, gx) - ox
     for cz in range(4):
-        kz = (_clamp(fz + cz, gz) - oz) * nxy
+        kz = (clamp(fz + cz, gz) - oz) * nxy
         plane = 0.0
         for cy in range(4):
-            row = kz + (_clamp(fy + cy, gy) - oy) * nx
+            row = kz + (clamp(fy + cy, gy) - oy) * nx
             plane += wy[cy] * (wx[0] * flat[row + x0] + wx[1] * flat[row + x1]
                                + wx[2] * flat[row + x2] + wx[3] * flat[row + x3])
         value += wz[cz] * plane
@@ -218,13 +215,13 @@ def gradient(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1, fp2, radius, nta
     gy = 0.0
     gz = 0.0
     for c in range(ntaps):
-        kz = _clamp(fz + c, gshape[0]) - offset[0]
+        kz = clamp(fz + c, gshape[0]) - offset[0]
         for b in range(ntaps):
-            ky = _clamp(fy + b, gshape[1]) - offset[1]
+            ky = clamp(fy + b, gshape[1]) - offset[1]
             row = 0.0
             drow = 0.0
             for a in range(ntaps):
-                v = data[kz, ky, _clamp(fx + a, gshape[2]) - offset[2]]
+                v = data[kz, ky, clamp(fx + a, gshape[2]) - offset[2]]
                 row += wx[a] * v
                 drow += dx[a] * v
             gx += wz[c] * wy[b] * drow

@@ -17,8 +17,8 @@ from numba import prange
 
 from vrlib._kernels._jit import jit, parallel_jit
 from vrlib._kernels.filters import weight
-from vrlib._kernels.raycast import _lookup
-from vrlib._kernels.sampling import _clamp
+from vrlib._kernels.sampling import clamp
+from vrlib._kernels.tables import lookup
 
 
 @parallel_jit
@@ -70,7 +70,7 @@ def _over(value, fraction, tstart, tinv, alpha_tab, color_tab, buf, y, x):
     segment length over the table's: ``1 - alpha' = (1 - alpha) ** fraction``, the colour
     scaled with the opacity (the first and last slices of a volume reach half a slice spacing
     into it; perspective rays cross the slices at their own angles)."""
-    i, w = _lookup((value - tstart) * tinv, alpha_tab.shape[0])
+    i, w = lookup((value - tstart) * tinv, alpha_tab.shape[0])
     alpha = alpha_tab[i] + w * (alpha_tab[i + 1] - alpha_tab[i])
     if not alpha > 0.0:
         return
@@ -179,7 +179,7 @@ def shear_slices(slices, order, scale, di, dj, fraction, fkind, fp0, fp1, fp2, r
             hi = -1
             for b in range(ntaps):
                 wj[b] = weight(fkind, fp0, fp1, fp2, j - (j_first + b))
-                rows[b] = _clamp(j_first + b, n_j)
+                rows[b] = clamp(j_first + b, n_j)
                 if first[k, rows[b]] <= last[k, rows[b]]:
                     lo = min(lo, first[k, rows[b]])
                     hi = max(hi, last[k, rows[b]])
@@ -216,7 +216,7 @@ def shear_slices(slices, order, scale, di, dj, fraction, fkind, fp0, fp1, fp2, r
                     for b in range(ntaps):
                         line = 0.0
                         for a in range(ntaps):
-                            line += wi[a] * slices[k, rows[b], _clamp(i0 + a, n_i)]
+                            line += wi[a] * slices[k, rows[b], clamp(i0 + a, n_i)]
                         value += wj[b] * line
                 done += 1
                 part = end if uniform else end * fraction[big_j, big_i]

@@ -27,24 +27,19 @@ import numpy as np
 from numba import prange
 
 from vrlib._kernels._jit import jit, parallel_jit
-from vrlib._kernels.raycast import _lookup, pixel_ray
+from vrlib._kernels.camera import (
+    FORWARD,
+    PIXEL,
+    camera_coords,
+    is_perspective,
+    on_plane,
+    pixel_ray,
+    project,
+)
+from vrlib._kernels.tables import interpolate, interpolate_channel
 
 SHEET, DIRECT = 0, 1
 RADIAL, PLANAR = 0, 1
-
-
-@jit
-def _table_value(start, inv, tab, value):
-    """Density table at ``value``, linearly interpolated and clamped (the shared lookup)."""
-    i, w = _lookup((value - start) * inv, tab.shape[0])
-    return tab[i] + w * (tab[i + 1] - tab[i])
-
-
-@jit
-def _emission(start, inv, tab, value, channel):
-    """Emission table's ``channel`` at ``value``, as :func:`_table_value`."""
-    i, w = _lookup((value - start) * inv, tab.shape[0])
-    return tab[i, channel] + w * (tab[i + 1, channel] - tab[i, channel])
 
 
 @jit
@@ -72,33 +67,15 @@ def footprint_at(kind, extent, extent_v, radial, planar, u, v):
 
 
 @jit
-def _camera_coords(camera, x, y, z):
-    """(right, up, depth) of a world point, from the view's origin plane or eye."""
-    distance = camera[14]
-    if distance == 0.0:
-        radius = camera[13]
-        sx = x - (camera[0] - radius * camera[9])
-        sy = y - (camera[1] - radius * camera[10])
-        sz = z - (camera[2] - radius * camera[11])
-    else:
-        sx = x - (camera[0] - distance * camera[9])
-        sy = y - (camera[1] - distance * camera[10])
-        sz = z - (camera[2] - distance * camera[11])
-    return (sx * camera[3] + sy * camera[4] + sz * camera[5],
-            sx * camera[6] + sy * camera[7] + sz * camera[8],
-            sx * camera[9] + sy * camera[10] + sz * camera[11])
-
-
-@jit
 def _q_range(camera, height, x0, y0, z0, dx, dy, dz, nq, row_lo, row_hi):
     """Indices ``q`` in ``[0, nq)`` of the points ``(x0, y0, z0) + q (dx, dy, dz)`` whose image
     row can lie in ``[row_lo, row_hi]``: a superset, found from the row's monotone (affine or,
     in perspective, linear-fractional) dependence on ``q``."""
-    px = camera[12]
-    _, a, c = _camera_coords(camera, x0, y0, z0)
-    _, a1, c1 = _camera_coords(camera, x0 + dx, y0 + dy, z0 + dz)
+    px = camera[PIXEL]
+    _, a, c = camera_coords(camera, x0, y0, z0)
+    _, a1, c1 = camera_coords(camera, x0 + dx, y0 + dy, z0 + dz)
     b, d = a1 - a, c1 - c
-    if camera[14] == 0.0:
+    if not is_perspective(camera):
         c, d = 1.0, 0.0
     elif c <= 0.0 or c + d * (nq - 1) <= 0.0:
         return 0, nq - 1  # part of the line is behind the eye: take it all
@@ -117,18 +94,6 @@ def _q_range(camera, height, x0, y0, z0, dx, dy, dz, nq, row_lo, row_hi):
         lo = min(lo, q)
         hi = max(hi, q)
     return max(0, int(math.floor(lo)) - 1), min(nq - 1, int(math.ceil(hi)) + 1)
-
-
-@jit
-def _project(camera, height, width, x, y, z):
-    """Continuous image position (row, col) and depth of a world point (as View.project)."""
-    cx, cy, depth = _camera_coords(camera, x, y, z)
-    if camera[14] != 0.0:
-        if depth <= 0.0:
-            return math.nan, math.nan, depth
-        cx /= depth
-        cy /= depth
-    return 0.5 * height - cy / camera[12], cx / camera[12] + 0.5 * width, depth
 
 
 @parallel_jit
@@ -181,9 +146,9 @@ def splat(data, origin, spacing, camera, height, width, axis, slices,
     pa = 1 if axis == 0 else 0
     qa = 1 if axis == 2 else 2
     np_, nq = counts[pa], counts[qa]
-    px = camera[12]
-    perspective = camera[14] != 0.0
-    fwd = (camera[9], camera[10], camera[11])
+    px = camera[PIXEL]
+    perspective = is_perspective(camera)
+    fwd = (camera[FORWARD], camera[FORWARD + 1], camera[FORWARD + 2])
     length_ortho = spacing[axis] / max(abs(fwd[axis]), 1e-300)
     for it in prange(order.shape[0]):
         b = order[it]
@@ -219,13 +184,13 @@ def splat(data, origin, spacing, camera, height, width, axis, slices,
                     if cull and f == 0.0:
                         continue  # adds nothing to a sheet, and has no density to draw
                     if mode == DIRECT:
-                        dens = _table_value(vstart, vinv, dens_tab, f)
+                        dens = interpolate(dens_tab, vstart, vinv, f)
                         if cull and not dens > 0.0:
                             continue
                     x = origin[0] + i * spacing[0]
                     y = origin[1] + j * spacing[1]
                     z = origin[2] + k * spacing[2]
-                    row_c, col_c, depth = _project(camera, height, width, x, y, z)
+                    row_c, col_c, depth = project(camera, height, width, x, y, z)
                     if not depth > 0.0 or row_c != row_c:
                         continue
                     reach_u = extent / px / depth if perspective else extent / px
@@ -242,9 +207,9 @@ def splat(data, origin, spacing, camera, height, width, axis, slices,
                             r1 == height and row_c >= height):
                         counted += 1
                     if mode == DIRECT:
-                        er = _emission(vstart, vinv, emit_tab, f, 0)
-                        eg = _emission(vstart, vinv, emit_tab, f, 1)
-                        eb = _emission(vstart, vinv, emit_tab, f, 2)
+                        er = interpolate_channel(emit_tab, vstart, vinv, f, 0)
+                        eg = interpolate_channel(emit_tab, vstart, vinv, f, 1)
+                        eb = interpolate_channel(emit_tab, vstart, vinv, f, 2)
                     for r in range(top, bottom + 1):
                         for c in range(left, right + 1):
                             if out[r, c, 3] >= threshold:
@@ -255,8 +220,7 @@ def splat(data, origin, spacing, camera, height, width, axis, slices,
                                 t = wx * d[0] + wy * d[1] + wz * d[2]
                                 # Ray point minus voxel, perpendicular to the ray.
                                 ox_, oy_, oz_ = t * d[0] - wx, t * d[1] - wy, t * d[2] - wz
-                                u = ox_ * camera[3] + oy_ * camera[4] + oz_ * camera[5]
-                                v = ox_ * camera[6] + oy_ * camera[7] + oz_ * camera[8]
+                                u, v = on_plane(camera, ox_, oy_, oz_)
                             else:
                                 u = (c + 0.5 - col_c) * px
                                 v = (row_c - r - 0.5) * px
@@ -289,13 +253,16 @@ def splat(data, origin, spacing, camera, height, width, axis, slices,
                         else:
                             length = length_ortho
                         value = integral / length
-                        dens = _table_value(vstart, vinv, dens_tab, value)
+                        dens = interpolate(dens_tab, vstart, vinv, value)
                         if not dens > 0.0:
                             continue
                         weight = (1.0 - out[r, c, 3]) * -math.expm1(-dens * length)
-                        out[r, c, 0] += weight * _emission(vstart, vinv, emit_tab, value, 0)
-                        out[r, c, 1] += weight * _emission(vstart, vinv, emit_tab, value, 1)
-                        out[r, c, 2] += weight * _emission(vstart, vinv, emit_tab, value, 2)
+                        out[r, c, 0] += weight * interpolate_channel(emit_tab, vstart, vinv,
+                                                                             value, 0)
+                        out[r, c, 1] += weight * interpolate_channel(emit_tab, vstart, vinv,
+                                                                             value, 1)
+                        out[r, c, 2] += weight * interpolate_channel(emit_tab, vstart, vinv,
+                                                                             value, 2)
                         out[r, c, 3] += weight
         voxels[b] = counted
         pixels[b] = drawn

@@ -97,7 +97,7 @@ class KdTree:
                 return
             axis, position, left, right = node
             world_axis = 2 - axis
-            if eye is None:
+            if not view.is_perspective:
                 low_first = forward[world_axis] >= 0.0
             else:
                 plane = origin[world_axis] + position * spacing[world_axis]

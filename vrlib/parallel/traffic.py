@@ -3,9 +3,10 @@
 Each function returns :class:`Messages` (source node, destination node, bytes), ready to be
 routed on a :class:`~vrlib.parallel.network.Network`. Object partitions send image fragments:
 a brick's local image is the pixels whose centres fall in the bounding rectangle of its
-projected box (what a renderer that tracks its footprint would send). Image partitions send
-voxels: a voxel goes to every screen tile whose rays can read it, that is every tile within
-the filter's reach of its projection.
+projected box (:func:`footprint_rect`, what a renderer that tracks its footprint would send),
+and each compositor of :data:`vrlib.parallel.composite.COMPOSITORS` sizes its own frame from
+them. Image partitions send voxels (here): a voxel goes to every screen tile whose rays can
+read it, that is every tile within the filter's reach of its projection.
 """
 
 from __future__ import annotations
@@ -15,8 +16,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Messages", "footprint_rect", "object_fragments", "binary_swap", "gather",
-           "image_static", "image_dynamic", "swap_slots", "swap_halves"]
+from vrlib.parallel.rects import area
+
+__all__ = ["Messages", "footprint_rect", "gather", "image_static", "image_dynamic"]
 
 #: Most voxels projected when counting an image partition's traffic; larger volumes are
 #: counted on a sub-lattice whose every voxel stands for ``stride^3`` of them.
@@ -89,170 +91,6 @@ def footprint_rect(view, lo, hi):
     return (r0, r1, c0, c1)
 
 
-def _area(rect):
-    r0, r1, c0, c1 = rect
-    return max(r1 - r0, 0) * max(c1 - c0, 0)
-
-
-def _intersect(a, b):
-    return (max(a[0], b[0]), min(a[1], b[1]), max(a[2], b[2]), min(a[3], b[3]))
-
-
-def _union(a, b):
-    if _area(a) == 0:
-        return b
-    if _area(b) == 0:
-        return a
-    return (min(a[0], b[0]), max(a[1], b[1]), min(a[2], b[2]), max(a[3], b[3]))
-
-
-def _tile_overlaps(tiles, rect):
-    """Owners and overlapping pixel counts of the tiles meeting ``rect``."""
-    r0, r1, c0, c1 = rect
-    if r1 <= r0 or c1 <= c0:
-        return np.zeros(0, np.int64), np.zeros(0)
-    i0 = np.searchsorted(tiles.rows, r0, side="right") - 1
-    i1 = np.searchsorted(tiles.rows, r1, side="left")
-    j0 = np.searchsorted(tiles.cols, c0, side="right") - 1
-    j1 = np.searchsorted(tiles.cols, c1, side="left")
-    h = np.minimum(r1, tiles.rows[i0 + 1:i1 + 1]) - np.maximum(r0, tiles.rows[i0:i1])
-    w = np.minimum(c1, tiles.cols[j0 + 1:j1 + 1]) - np.maximum(c0, tiles.cols[j0:j1])
-    return tiles.owner[i0:i1, j0:j1].ravel(), np.outer(h, w).ravel().astype(np.float64)
-
-
-def object_fragments(tree, owners, tiles, view, origin, spacing, *, bytes_per_pixel=4):
-    """Direct send: each brick's local image, cut by the screen tiles, goes to each tile's
-    owner.
-
-    Returns
-    -------
-    messages : Messages
-    local_pixels : ndarray
-        Pixels of each brick's local image (its footprint rectangle).
-
-    Examples
-    --------
-    >>> from vrlib import View
-    >>> from vrlib.parallel.decompose import screen_tiles, split
-    >>> view = View([0, 0, -1], up=[0, 1, 0], size=8, radius=1.0)   # looking down z
-    >>> tree = split((4, 4, 4), 2, shape="shafts")          # lower and upper halves in y
-    >>> tiles = screen_tiles(8, 8, 2)                       # left and right halves
-    >>> msgs, local = object_fragments(tree, [0, 1], tiles, view, (-1, -1, -1),
-    ...                                (0.5, 0.5, 0.5), bytes_per_pixel=1)
-    >>> local.tolist(), msgs.sent_per_node(2).tolist()     # half of each goes across
-    ([32.0, 32.0], [16.0, 16.0])
-    """
-    nodes = max(int(np.max(owners)) + 1, tiles.nodes)
-    src, dst, size, local = [], [], [], []
-    for brick in tree.bricks:
-        rect = footprint_rect(view, *brick.world_box(origin, spacing))
-        local.append(_area(rect))
-        who, pixels = _tile_overlaps(tiles, rect)
-        src.append(np.full(who.size, owners[brick.index]))
-        dst.append(who)
-        size.append(pixels * bytes_per_pixel)
-    return (Messages.merged(np.concatenate(src), np.concatenate(dst), np.concatenate(size),
-                            nodes), np.array(local, dtype=np.float64))
-
-
-def swap_slots(tree):
-    """Binary swap's slots: the subtrees at depth ``floor(log2 P)`` of the k-d tree, each one
-    brick or two (a pair folded together before the swap), left to right.
-
-    Examples
-    --------
-    >>> from vrlib.parallel.decompose import split
-    >>> swap_slots(split((8, 8, 8), 3))           # brick 0 alone, bricks 1 and 2 folded
-    [0, (1, 4, 1, 2)]
-    """
-    depth = int(math.floor(math.log2(len(tree))))
-    slots = []
-
-    def visit(node, level):
-        if level == depth or not isinstance(node, tuple):
-            slots.append(node)
-            return
-        visit(node[2], level + 1)
-        visit(node[3], level + 1)
-
-    visit(tree.node, 0)
-    if len(slots) != 1 << depth:
-        raise ValueError("binary swap needs a k-d tree from vrlib.parallel.decompose.split "
-                         "(a perfect tree over its first floor(log2 P) levels)")
-    return slots
-
-
-def swap_halves(region, lower):
-    """One binary-swap round's split of a screen ``region`` ``(r0, r1, c0, c1)`` across its
-    longer side: ``(keep, give)``, the lower half kept by the partner with ``lower`` set.
-
-    Examples
-    --------
-    >>> swap_halves((0, 8, 0, 4), True), swap_halves((0, 8, 0, 4), False)[0]
-    (((0, 4, 0, 4), (4, 8, 0, 4)), (4, 8, 0, 4))
-    """
-    r0, r1, c0, c1 = region
-    if r1 - r0 >= c1 - c0:
-        mid = (r0 + r1) // 2
-        halves = ((r0, mid, c0, c1), (mid, r1, c0, c1))
-    else:
-        mid = (c0 + c1) // 2
-        halves = ((r0, r1, c0, mid), (r0, r1, mid, c1))
-    return halves if lower else halves[::-1]
-
-
-def binary_swap(tree, view, origin, spacing, *, bytes_per_pixel=4, bounded=True):
-    """Binary swap (Ma et al. 1994) on the k-d tree's bricks, brick ``i`` on node ``i``.
-
-    Pairs folded into one slot first send the second brick's image to the first; then in
-    round ``r`` slot ``s`` swaps halves of its current screen region with slot ``s ^ 2^r``.
-    With ``bounded`` a node sends only the part of the half inside the bounding rectangle of
-    what its group has rendered; otherwise the whole half (the classic count, ``W^2 (1 - 1/P)``
-    per node).
-
-    Examples
-    --------
-    >>> from vrlib import View
-    >>> from vrlib.parallel.decompose import split
-    >>> view = View.orbit(size=16)
-    >>> m = binary_swap(split((8, 8, 8), 4), view, (-1, -1, -1), (0.25, 0.25, 0.25),
-    ...                 bytes_per_pixel=1, bounded=False)
-    >>> m.sent_per_node(4).tolist()               # 16^2 x (1 - 1/4) each
-    [192.0, 192.0, 192.0, 192.0]
-    """
-    slots = swap_slots(tree)
-    full = (0, view.height, 0, view.width)
-    rects = [footprint_rect(view, *b.world_box(origin, spacing)) for b in tree.bricks]
-    nodes = len(tree)
-    src, dst, size = [], [], []
-    leader, held = [], []
-    for slot in slots:
-        if isinstance(slot, tuple):
-            first, second = slot[2], slot[3]
-            src.append(second)
-            dst.append(first)
-            size.append(_area(rects[second] if bounded else full) * bytes_per_pixel)
-            leader.append(first)
-            held.append(_union(rects[first], rects[second]))
-        else:
-            leader.append(slot)
-            held.append(rects[slot])
-    region = [full] * len(slots)
-    for r in range(int(math.log2(len(slots)))):
-        new_held = list(held)
-        for s in range(len(slots)):
-            partner = s ^ (1 << r)
-            keep, give = swap_halves(region[s], s < partner)
-            part = _intersect(give, held[s]) if bounded else give
-            src.append(leader[s])
-            dst.append(leader[partner])
-            size.append(_area(part) * bytes_per_pixel)
-            region[s] = keep
-            new_held[s] = _union(held[s], held[partner])
-        held = new_held
-    return Messages.merged(src, dst, size, nodes)
-
-
 def gather(tiles_or_regions, nodes, *, root=0, bytes_per_pixel=4):
     """Every node's finished pixels to ``root`` (the display): ``tiles_or_regions`` is a
     :class:`~vrlib.parallel.decompose.ScreenTiles` or a list of ``(node, rect)``.
@@ -270,7 +108,7 @@ def gather(tiles_or_regions, nodes, *, root=0, bytes_per_pixel=4):
         src = np.arange(nodes)
     else:
         src = np.array([n for n, _ in tiles_or_regions])
-        pixels = np.array([_area(r) for _, r in tiles_or_regions], dtype=float)
+        pixels = np.array([area(r) for _, r in tiles_or_regions], dtype=float)
     return Messages.merged(src, np.full(len(src), root), pixels * bytes_per_pixel, nodes)
 
 
@@ -300,7 +138,7 @@ def _project_samples(view, axes, origin, spacing):
 
 def _reach_pixels(view, depth, reach):
     """Filter reach ``reach`` (world units) in pixels at each ``depth``."""
-    if view.eye is None:
+    if not view.is_perspective:
         return np.full(depth.shape, reach / view.pixel_size)
     return reach * view.distance / (view.pixel_size * np.maximum(depth, 1e-12))
 

@@ -1,0 +1,72 @@
+"""The arguments every renderer shares, checked and normalised in one place.
+
+:func:`vrlib.render`, the MPI renderers (:mod:`vrlib.parallel.mpi`) and the reference renderer
+(:func:`vrlib.render_reference`) all take a view, a transfer function and (the sampling
+renderers) a filter and a step; each argument is checked here once, with one message, and the
+filter is built once (renderers below take a :class:`vrlib.filters.Filter`, never a name).
+"""
+
+from __future__ import annotations
+
+from vrlib import _validate
+from vrlib.filters import check_radius, make_filter
+from vrlib.transfer import Glow, TransferFunction
+from vrlib.view import View
+
+__all__ = ["check_view", "check_transfer", "render_arguments", "refuse_shading"]
+
+
+def check_view(view):
+    """Refuse anything but a :class:`vrlib.View`; return it."""
+    if not isinstance(view, View):
+        raise TypeError(f"view must be a vrlib.View, got {type(view).__name__}")
+    return view
+
+
+def check_transfer(transfer):
+    """The transfer function, ``Glow(1.0)`` when None; refuse anything else."""
+    transfer = Glow(1.0) if transfer is None else transfer
+    if not isinstance(transfer, TransferFunction):
+        raise TypeError(f"transfer must be a vrlib transfer function (Glow, LookupTransfer), "
+                        f"got {transfer!r}")
+    return transfer
+
+
+def render_arguments(view, filter, transfer, step, early_termination=1.0):
+    """Check the arguments the sampling renderers share.
+
+    Returns
+    -------
+    filt : Filter
+        Built from ``filter`` (a name, tuple or Filter), at most
+        :data:`vrlib.filters.MAX_RADIUS` wide.
+    transfer : TransferFunction
+    step : float
+        > 0.
+    early_termination : float
+        In (0, 1].
+
+    Examples
+    --------
+    >>> import vrlib
+    >>> render_arguments(vrlib.View.orbit(), "catmull-rom", None, 0.5)[0]
+    make_filter('catmull-rom')
+    >>> render_arguments(vrlib.View.orbit(), "catmull-rom", None, 0.0)
+    Traceback (most recent call last):
+    ...
+    ValueError: step must be > 0.0, got 0.0
+    """
+    check_view(view)
+    filt = check_radius(make_filter(filter))
+    transfer = check_transfer(transfer)
+    step = _validate.positive_number("step", step)
+    early_termination = _validate.finite_number("early_termination", early_termination,
+                                                low=0.0, high=1.0, low_open=True)
+    return filt, transfer, step, early_termination
+
+
+def refuse_shading(transfer, who):
+    """Refuse a shaded transfer function where ``who`` (a renderer) cannot shade."""
+    if transfer.shading is not None:
+        raise ValueError(f"{who} does not shade (it reconstructs no gradients); use "
+                         f"method='raycast' for shaded images")
