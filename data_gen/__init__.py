@@ -23,7 +23,7 @@ from data_gen.loaders import (
     load_npy,
     load_raw,
 )
-from vrlib import _validate
+from vrlib import validate
 
 #: Field constructors by name.
 FIELDS = {
@@ -57,7 +57,7 @@ def make_field(name, **params):
     ValueError: unknown field 'sphere'; known: 'gaussian-blob', 'blobs', 'random-blobs', \
 'marschner-lobb', 'smooth-sphere', 'grating', 'step-edge'
     """
-    _validate.choice("field", name, tuple(FIELDS))
+    validate.choice("field", name, tuple(FIELDS))
     try:
         return FIELDS[name](**params)
     except TypeError as exc:

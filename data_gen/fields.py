@@ -13,7 +13,7 @@ import math
 import numpy as np
 from scipy import special
 
-from vrlib import _validate
+from vrlib import validate
 from vrlib.volume import DEFAULT_EXTENT, Volume, check_extent
 
 __all__ = [
@@ -106,7 +106,7 @@ class Field:
         """
         if isinstance(shape, int | np.integer):
             shape = (shape, shape, shape)
-        shape = tuple(_validate.positive_int("shape", n, minimum=2) for n in shape)
+        shape = tuple(validate.positive_int("shape", n, minimum=2) for n in shape)
         if len(shape) != 3:
             raise ValueError(f"shape must be an int or (nz, ny, nx), got {shape!r}")
         if np.dtype(dtype) not in (np.dtype(np.float32), np.dtype(np.float64)):
@@ -185,9 +185,9 @@ class GaussianBlob(Field):
     name = "gaussian-blob"
 
     def __init__(self, center=(0.0, 0.0, 0.0), sigma=0.3, amplitude=1.0):
-        self.center = _validate.vector3("center", center)
-        self.sigma = _validate.positive_number("sigma", sigma)
-        self.amplitude = _validate.finite_number("amplitude", amplitude)
+        self.center = validate.vector3("center", center)
+        self.sigma = validate.positive_number("sigma", sigma)
+        self.amplitude = validate.finite_number("amplitude", amplitude)
 
     def params(self):
         return {"center": self.center.tolist(), "sigma": self.sigma, "amplitude": self.amplitude}
@@ -252,7 +252,7 @@ class BlobSum(Field):
 
         ``sigma`` and ``amplitude`` are (low, high) ranges drawn uniformly.
         """
-        count = _validate.positive_int("count", count)
+        count = validate.positive_int("count", count)
         rng = np.random.default_rng(seed)
         centers = rng.uniform(-region, region, size=(count, 3))
         sigmas = rng.uniform(*sigma, size=count)
@@ -296,8 +296,8 @@ class MarschnerLobb(Field):
     name = "marschner-lobb"
 
     def __init__(self, fM=6.0, alpha=0.25):
-        self.fM = _validate.positive_number("fM", fM)
-        self.alpha = _validate.finite_number("alpha", alpha, low=0.0)
+        self.fM = validate.positive_number("fM", fM)
+        self.alpha = validate.finite_number("alpha", alpha, low=0.0)
 
     def params(self):
         return {"fM": self.fM, "alpha": self.alpha}
@@ -324,10 +324,10 @@ class SmoothSphere(Field):
     name = "smooth-sphere"
 
     def __init__(self, center=(0.0, 0.0, 0.0), radius=0.6, width=0.05, amplitude=1.0):
-        self.center = _validate.vector3("center", center)
-        self.radius = _validate.positive_number("radius", radius)
-        self.width = _validate.positive_number("width", width)
-        self.amplitude = _validate.finite_number("amplitude", amplitude)
+        self.center = validate.vector3("center", center)
+        self.radius = validate.positive_number("radius", radius)
+        self.width = validate.positive_number("width", width)
+        self.amplitude = validate.finite_number("amplitude", amplitude)
 
     def params(self):
         return {"center": self.center.tolist(), "radius": self.radius, "width": self.width,
@@ -361,10 +361,10 @@ class Grating(Field):
     name = "grating"
 
     def __init__(self, frequency=4.0, direction=(1.0, 0.0, 0.0), amplitude=1.0, phase=0.0):
-        self.frequency = _validate.positive_number("frequency", frequency)
-        self.direction = _validate.vector3("direction", direction, unit=True)
-        self.amplitude = _validate.finite_number("amplitude", amplitude)
-        self.phase = _validate.finite_number("phase", phase)
+        self.frequency = validate.positive_number("frequency", frequency)
+        self.direction = validate.vector3("direction", direction, unit=True)
+        self.amplitude = validate.finite_number("amplitude", amplitude)
+        self.phase = validate.finite_number("phase", phase)
 
     def params(self):
         return {"frequency": self.frequency, "direction": self.direction.tolist(),
@@ -403,10 +403,10 @@ class StepEdge(Field):
     name = "step-edge"
 
     def __init__(self, normal=(1.0, 0.0, 0.0), offset=0.0, low=0.0, high=1.0):
-        self.normal = _validate.vector3("normal", normal, unit=True)
-        self.offset = _validate.finite_number("offset", offset)
-        self.low = _validate.finite_number("low", low)
-        self.high = _validate.finite_number("high", high)
+        self.normal = validate.vector3("normal", normal, unit=True)
+        self.offset = validate.finite_number("offset", offset)
+        self.low = validate.finite_number("low", low)
+        self.high = validate.finite_number("high", high)
 
     def params(self):
         return {"normal": self.normal.tolist(), "offset": self.offset, "low": self.low,

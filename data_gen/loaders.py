@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from vrlib import _validate
+from vrlib import validate
 from vrlib.volume import Volume
 
 __all__ = ["load", "load_npy", "load_nifti", "load_raw", "load_mni_template", "fitted_extent"]
@@ -71,12 +71,12 @@ def load_raw(path, shape, dtype, *, byteorder="little", offset=0, extent=None):
     7.0
     """
     path = _existing(path)
-    shape = tuple(_validate.positive_int("shape", n, minimum=2) for n in shape)
+    shape = tuple(validate.positive_int("shape", n, minimum=2) for n in shape)
     if len(shape) != 3:
         raise ValueError(f"shape must be (nz, ny, nx), got {shape!r}")
-    _validate.choice("byteorder", byteorder, ("little", "big"))
+    validate.choice("byteorder", byteorder, ("little", "big"))
     dt = np.dtype(dtype).newbyteorder("<" if byteorder == "little" else ">")
-    offset = _validate.positive_int("offset", offset, minimum=0)
+    offset = validate.positive_int("offset", offset, minimum=0)
     expected = offset + int(np.prod(shape)) * dt.itemsize
     actual = path.stat().st_size
     if actual != expected:

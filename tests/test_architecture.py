@@ -80,7 +80,7 @@ def test_kernels_import_only_shared_kernel_helpers(path):
                          ids=lambda p: str(p.relative_to(ROOT)))
 def test_no_private_names_across_modules(path):
     """No module imports a private name (``_name``) of another module, and nothing outside
-    vrlib imports its private modules (``vrlib._kernels``, ``vrlib._validate``...); inside a
+    vrlib imports its private modules (``vrlib._kernels``, ``vrlib._scheduling``...); inside a
     package, its private helper modules are its own."""
     this = module_name(path)
     package = this.split(".")[0]

@@ -8,7 +8,7 @@ filter is built once (renderers below take a :class:`vrlib.filters.Filter`, neve
 
 from __future__ import annotations
 
-from vrlib import _validate
+from vrlib import validate
 from vrlib.filters import check_radius, make_filter
 from vrlib.transfer import Glow, TransferFunction
 from vrlib.view import View
@@ -59,8 +59,8 @@ def render_arguments(view, filter, transfer, step, early_termination=1.0):
     check_view(view)
     filt = check_radius(make_filter(filter))
     transfer = check_transfer(transfer)
-    step = _validate.positive_number("step", step)
-    early_termination = _validate.finite_number("early_termination", early_termination,
+    step = validate.positive_number("step", step)
+    early_termination = validate.finite_number("early_termination", early_termination,
                                                 low=0.0, high=1.0, low_open=True)
     return filt, transfer, step, early_termination
 

@@ -25,7 +25,7 @@ import math
 import numpy as np
 from scipy.spatial import ConvexHull
 
-from vrlib import _validate
+from vrlib import validate
 from vrlib.filters import make_filter
 
 __all__ = ["feature_error", "fourier_bound", "required_ratio", "error_samples"]
@@ -36,7 +36,7 @@ _PERIODS = 300  # periods of the frequency response integrated on each side
 
 
 def _check(ratio, dims):
-    ratio = _validate.finite_number("ratio", ratio, low=0.0, low_open=True)
+    ratio = validate.finite_number("ratio", ratio, low=0.0, low_open=True)
     if dims not in (1, 3):
         raise ValueError(f"dims must be 1 or 3, got {dims!r}")
     return ratio
@@ -191,7 +191,7 @@ def required_ratio(filt, target, *, dims=1, low=0.25, high=8.0):
     >>> round(required_ratio("trilinear", 0.05), 2)
     1.56
     """
-    target = _validate.finite_number("target", target, low=0.0, low_open=True)
+    target = validate.finite_number("target", target, low=0.0, low_open=True)
     filt = make_filter(filt)
     grid = np.geomspace(low, high, int(8 * math.log2(high / low)) + 1)[::-1]
     if _error(filt, float(grid[0]), dims) > target:

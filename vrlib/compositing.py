@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from vrlib import _validate
+from vrlib import validate
 
 __all__ = [
     "over",
@@ -81,7 +81,7 @@ def composite(samples, *, order="front-to-back"):
     samples = _rgba("samples", samples)
     if samples.ndim < 2:
         raise ValueError(f"samples must have shape (..., n, 4), got {samples.shape}")
-    _validate.choice("order", order, ORDERS)
+    validate.choice("order", order, ORDERS)
     n = samples.shape[-2]
     acc = np.zeros(samples.shape[:-2] + (4,))
     if order == "front-to-back":
@@ -116,7 +116,7 @@ def segment_alpha(density, length, *, model="exact"):
     >>> round(float(segment_alpha(1.0, 1.0)), 6)
     0.632121
     """
-    _validate.choice("model", model, SEGMENT_MODELS)
+    validate.choice("model", model, SEGMENT_MODELS)
     x = np.asarray(density, dtype=np.float64) * np.asarray(length, dtype=np.float64)
     if model == "exact":
         return -np.expm1(-x)
@@ -138,10 +138,10 @@ def correct_opacity(alpha, step, reference_step):
     >>> correct_opacity(0.75, 0.5, 1.0).item()
     0.5
     """
-    a = _validate.finite_array("alpha", alpha)
+    a = validate.finite_array("alpha", alpha)
     if np.any((a < 0.0) | (a > 1.0)):
         raise ValueError("alpha must lie in [0, 1]")
-    ratio = _validate.positive_number("step", step) / _validate.positive_number(
+    ratio = validate.positive_number("step", step) / validate.positive_number(
         "reference_step", reference_step
     )
     with np.errstate(divide="ignore"):

@@ -22,7 +22,7 @@ import time
 
 import numpy as np
 
-from vrlib import _validate
+from vrlib import validate
 
 __all__ = ["machine", "points", "measure", "fit_model"]
 
@@ -94,7 +94,7 @@ def measure(render, *, repeats=3, warmup=True):
     >>> seconds > 0 and image.stats.samples > 0
     True
     """
-    repeats = _validate.positive_int("repeats", repeats)
+    repeats = validate.positive_int("repeats", repeats)
     if warmup:
         render()
     best = float("inf")

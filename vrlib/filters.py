@@ -33,7 +33,7 @@ import math
 import numpy as np
 from scipy import special
 
-from vrlib import _validate
+from vrlib import validate
 from vrlib._kernels import filters as _k
 
 __all__ = [
@@ -275,8 +275,8 @@ class MitchellNetravali(_Piecewise):
     partition_of_unity = True
 
     def __init__(self, B, C, *, name="mitchell-netravali"):
-        self.B = _validate.finite_number("B", B)
-        self.C = _validate.finite_number("C", C)
+        self.B = validate.finite_number("B", B)
+        self.C = validate.finite_number("C", C)
         self.name = name
         # The two cubic pieces (the kernels' one definition), divided by 6, ascending powers.
         near, far = _k.cubic_coefficients(self.B, self.C)
@@ -332,8 +332,8 @@ class Gaussian(Filter):
     partition_of_unity = False
 
     def __init__(self, sigma=0.6, radius=2.0):
-        self.sigma = _validate.positive_number("sigma", sigma)
-        self.radius = _validate.positive_number("radius", radius)
+        self.sigma = validate.positive_number("sigma", sigma)
+        self.radius = validate.positive_number("radius", radius)
         u = self.radius / (self.sigma * math.sqrt(2.0))
         self._norm = self.sigma * math.sqrt(2.0 * math.pi) * math.erf(u)
 
@@ -452,7 +452,7 @@ def make_filter(spec, *args, **params):
         raise TypeError(
             f"filter must be a name, a (name, *params) tuple or a Filter, got {spec!r}"
         )
-    _validate.choice("filter", spec, tuple(FILTERS))
+    validate.choice("filter", spec, tuple(FILTERS))
     try:
         return FILTERS[spec](*args, **params)
     except TypeError as exc:

@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vrlib import _validate
+from vrlib import validate
 from vrlib.filters import Gaussian, make_filter
 
 __all__ = ["Footprint", "footprint", "RADIAL", "PLANAR"]
@@ -175,7 +175,7 @@ def footprint(filt, spacing, basis, *, resolution=129):
     1.0
     """
     filt = make_filter(filt)
-    resolution = _validate.positive_int("footprint resolution", resolution, minimum=8)
+    resolution = validate.positive_int("footprint resolution", resolution, minimum=8)
     if resolution > 1024:
         raise ValueError(f"footprint resolution must be at most 1024, got {resolution}")
     spacing = tuple(float(s) for s in spacing)

@@ -7,7 +7,7 @@ from pathlib import Path
 
 import numpy as np
 
-from vrlib import _validate
+from vrlib import validate
 from vrlib._png import encode_png
 from vrlib.atomic import atomic_path
 
@@ -82,7 +82,7 @@ class Image:
     """
 
     def __init__(self, rgba, stats=None):
-        arr = _validate.finite_array("rgba", rgba, ndim=3)
+        arr = validate.finite_array("rgba", rgba, ndim=3)
         if arr.shape[2] != 4:
             raise ValueError(f"rgba must have shape (height, width, 4), got {arr.shape}")
         alpha = arr[..., 3]
@@ -109,7 +109,7 @@ class Image:
 
     def composited(self, background=(0.0, 0.0, 0.0)):
         """RGB over an opaque ``background`` colour."""
-        bg = _validate.vector3("background", background)
+        bg = validate.vector3("background", background)
         return self.rgba[..., :3] + (1.0 - self.rgba[..., 3:4]) * bg
 
     def save(self, path, *, bits=8, background=(0.0, 0.0, 0.0)):

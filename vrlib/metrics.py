@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 from skimage.metrics import structural_similarity
 
-from vrlib import _validate
+from vrlib import validate
 from vrlib.image import Image
 
 __all__ = ["rmse", "max_abs_error", "psnr", "ssim", "csf_error", "METRICS"]
@@ -24,7 +24,7 @@ def _pair(a, b):
     for name, value in (("a", a), ("b", b)):
         if isinstance(value, Image):
             value = value.rgba
-        arrays.append(_validate.finite_array(name, value))
+        arrays.append(validate.finite_array(name, value))
     a, b = arrays
     if a.shape != b.shape:
         raise ValueError(f"images must have the same shape, got {a.shape} and {b.shape}")
@@ -65,7 +65,7 @@ def psnr(a, b, *, data_range=1.0):
     >>> round(psnr(np.zeros(4), np.full(4, 0.1)), 6)
     20.0
     """
-    peak = _validate.positive_number("data_range", data_range)
+    peak = validate.positive_number("data_range", data_range)
     err = rmse(a, b)
     if err == 0.0:
         return float("inf")
@@ -85,7 +85,7 @@ def ssim(a, b, *, data_range=1.0):
     1.0
     """
     a, b = _pair(a, b)
-    peak = _validate.positive_number("data_range", data_range)
+    peak = validate.positive_number("data_range", data_range)
     if a.ndim not in (2, 3):
         raise ValueError(f"ssim needs 2-D images or 3-D (H, W, C) images, got shape {a.shape}")
     if min(a.shape[:2]) < 7:
@@ -125,7 +125,7 @@ def csf_error(a, b, *, pixels_per_degree=32.0):
     True
     """
     a, b = _pair(a, b)
-    ppd = _validate.positive_number("pixels_per_degree", pixels_per_degree)
+    ppd = validate.positive_number("pixels_per_degree", pixels_per_degree)
     if a.ndim not in (2, 3):
         raise ValueError(f"csf_error needs 2-D or (H, W, C) images, got shape {a.shape}")
     diff = a - b

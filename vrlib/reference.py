@@ -24,7 +24,7 @@ import time
 
 import numpy as np
 
-from vrlib import _validate
+from vrlib import validate
 from vrlib.arguments import check_transfer, check_view
 from vrlib.image import Image, RenderStats
 from vrlib.volume import check_extent
@@ -138,9 +138,9 @@ def render_reference(field, view, *, transfer=None, tol=1e-6, extent=None, segme
         raise TypeError(f"field must be an analytic data_gen field, got {type(field).__name__}")
     check_view(view)
     transfer = check_transfer(transfer)
-    tol = _validate.finite_number("tol", tol, low=0.0, low_open=True)
-    segments = _validate.positive_int("segments", segments)
-    chunk = _validate.positive_int("chunk", chunk)
+    tol = validate.finite_number("tol", tol, low=0.0, low_open=True)
+    segments = validate.positive_int("segments", segments)
+    chunk = validate.positive_int("chunk", chunk)
     box = check_extent(field.bounds if extent is None else extent)
     start = time.perf_counter()
     origins, directions = view.rays()

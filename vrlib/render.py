@@ -8,7 +8,7 @@ import numbers
 
 import numba
 
-from vrlib import _validate
+from vrlib import validate
 from vrlib.arguments import render_arguments
 from vrlib.raycast import render_raycast
 from vrlib.reference import render_reference
@@ -108,7 +108,7 @@ def render(volume, view, *, method="raycast", filter="trilinear", transfer=None,
     """
     if not isinstance(volume, Volume):
         raise TypeError(f"volume must be a vrlib.Volume, got {type(volume).__name__}")
-    _validate.choice("method", method, tuple(METHODS))
+    validate.choice("method", method, tuple(METHODS))
     filt, transfer, step, early_termination = render_arguments(view, filter, transfer, step,
                                                                early_termination)
     if not isinstance(empty_space_skipping, bool):

@@ -27,7 +27,7 @@ import time
 
 import numpy as np
 
-from vrlib import _validate
+from vrlib import validate
 from vrlib._kernels import shear as _kernel
 from vrlib.arguments import refuse_shading
 from vrlib.image import Image, RenderStats
@@ -201,7 +201,7 @@ _FLOAT32_SAFE = (1e-30, 1e30)
 def _intermediate(intermediate, volume):
     """Storage type of the intermediate volumes: ``"auto"`` takes float32 unless the
     volume's non-zero magnitudes fall outside what float32 holds safely."""
-    _validate.choice("intermediate", intermediate, ("auto", *INTERMEDIATES))
+    validate.choice("intermediate", intermediate, ("auto", *INTERMEDIATES))
     if intermediate != "auto":
         return INTERMEDIATES[intermediate]
 

@@ -16,7 +16,7 @@ import time
 
 import numpy as np
 
-from vrlib import _validate
+from vrlib import validate
 from vrlib._kernels import shear as _kernel
 from vrlib.arguments import refuse_shading
 from vrlib.image import Image, RenderStats
@@ -138,7 +138,7 @@ def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
         (lossy, as VolPack's threshold). Skipping is on with ``empty_space_skipping`` and for
         filters without negative lobes.
     """
-    min_opacity = _validate.finite_number("min_opacity", min_opacity, low=0.0, high=1.0,
+    min_opacity = validate.finite_number("min_opacity", min_opacity, low=0.0, high=1.0,
                                           high_open=True)
     refuse_shading(transfer, "shear-warp")
     ntaps = filt.taps

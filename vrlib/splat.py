@@ -21,7 +21,7 @@ import time
 import numba
 import numpy as np
 
-from vrlib import _validate
+from vrlib import validate
 from vrlib._kernels import splat as _kernel
 from vrlib._scheduling import balanced_order
 from vrlib.arguments import refuse_shading
@@ -102,7 +102,7 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
     footprint_resolution : int
         Footprint table entries per axis (:func:`vrlib.footprint.footprint`).
     """
-    _validate.choice("mode", mode, MODES)
+    validate.choice("mode", mode, MODES)
     refuse_shading(transfer, "splatting")
     axis, ascending = principal_axis(view, volume)
     extent = volume.extent

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from vrlib import _validate
+from vrlib import validate
 
 __all__ = ["TransferFunction", "Glow", "LookupTransfer", "Phong"]
 
@@ -45,15 +45,15 @@ class Phong:
     """
 
     def __init__(self, *, ambient=0.3, diffuse=0.7, specular=0.0, shininess=20.0, light=None):
-        self.ambient = _validate.finite_number("ambient", ambient, low=0.0)
-        self.diffuse = _validate.finite_number("diffuse", diffuse, low=0.0)
-        self.specular = _validate.finite_number("specular", specular, low=0.0)
-        self.shininess = _validate.positive_number("shininess", shininess)
-        self.light = None if light is None else _validate.vector3("light", light, unit=True)
+        self.ambient = validate.finite_number("ambient", ambient, low=0.0)
+        self.diffuse = validate.finite_number("diffuse", diffuse, low=0.0)
+        self.specular = validate.finite_number("specular", specular, low=0.0)
+        self.shininess = validate.positive_number("shininess", shininess)
+        self.light = None if light is None else validate.vector3("light", light, unit=True)
 
     def factor(self, gradient, view_dir):
         """Multiplier of the emission for gradients ``(..., 3)`` seen from ``view_dir``."""
-        v = _validate.vector3("view_dir", view_dir, unit=True)
+        v = validate.vector3("view_dir", view_dir, unit=True)
         light = v if self.light is None else self.light
         g = np.asarray(gradient, dtype=np.float64)
         norm = np.linalg.norm(g, axis=-1)
@@ -64,7 +64,7 @@ class Phong:
 
     def highlight(self, gradient, view_dir):
         """Specular term (added to every colour channel) for gradients ``(..., 3)``."""
-        v = _validate.vector3("view_dir", view_dir, unit=True)
+        v = validate.vector3("view_dir", view_dir, unit=True)
         light = v if self.light is None else self.light
         half = light + v
         half = half / np.linalg.norm(half) if np.any(half) else light
@@ -189,7 +189,7 @@ class Glow(TransferFunction):
     """
 
     def __init__(self, scale=1.0, *, shading=None):
-        self.scale = _validate.positive_number("scale", scale)
+        self.scale = validate.positive_number("scale", scale)
         self.shading = _check_shading(shading)
 
     def opacity_density(self, values):
@@ -238,7 +238,7 @@ class LookupTransfer(TransferFunction):
     """
 
     def __init__(self, density, color=None, *, value_range=(0.0, 1.0), shading=None):
-        dens = _validate.finite_array("density", density, ndim=1)
+        dens = validate.finite_array("density", density, ndim=1)
         if dens.shape[0] < 2:
             raise ValueError(f"density table needs at least 2 entries, got {dens.shape[0]}")
         if np.any(dens < 0.0):
@@ -246,7 +246,7 @@ class LookupTransfer(TransferFunction):
         if color is None:
             col = np.ones((dens.shape[0], 3))
         else:
-            col = _validate.finite_array("color", color, ndim=2)
+            col = validate.finite_array("color", color, ndim=2)
             if col.shape != (dens.shape[0], 3):
                 raise ValueError(
                     f"color table must have shape ({dens.shape[0]}, 3) to match the density "
@@ -254,8 +254,8 @@ class LookupTransfer(TransferFunction):
                 )
             if np.any(col < 0.0):
                 raise ValueError("color table entries must be >= 0")
-        lo = _validate.finite_number("value_range[0]", value_range[0])
-        hi = _validate.finite_number("value_range[1]", value_range[1])
+        lo = validate.finite_number("value_range[0]", value_range[0])
+        hi = validate.finite_number("value_range[1]", value_range[1])
         if not hi > lo:
             raise ValueError(f"value_range must be increasing (low < high), got ({lo}, {hi})")
         self.density = dens
@@ -276,10 +276,10 @@ class LookupTransfer(TransferFunction):
         >>> np.round(tf.density, 12).tolist()
         [0.0, 4.0]
         """
-        a = _validate.finite_array("alpha", alpha, ndim=1)
+        a = validate.finite_array("alpha", alpha, ndim=1)
         if np.any((a < 0.0) | (a >= 1.0)):
             raise ValueError("alpha entries must lie in [0, 1) (1 would be infinite density)")
-        unit = _validate.positive_number("unit_distance", unit_distance)
+        unit = validate.positive_number("unit_distance", unit_distance)
         return cls(-np.log1p(-a) / unit, color, value_range=value_range, shading=shading)
 
     def _interp(self, table, values):

@@ -18,7 +18,7 @@ import math
 
 import numpy as np
 
-from vrlib import _validate
+from vrlib import validate
 from vrlib._kernels import camera as _camera
 
 __all__ = ["View", "PROJECTIONS", "principal_axis"]
@@ -34,10 +34,10 @@ def _image_size(size):
     if isinstance(size, tuple | list):
         if len(size) != 2:
             raise ValueError(f"size must be an int or a (height, width) pair, got {size!r}")
-        h = _validate.positive_int("size[0] (height)", size[0])
-        w = _validate.positive_int("size[1] (width)", size[1])
+        h = validate.positive_int("size[0] (height)", size[0])
+        w = validate.positive_int("size[1] (width)", size[1])
     else:
-        h = w = _validate.positive_int("size", size)
+        h = w = validate.positive_int("size", size)
     if max(h, w) > _MAX_SIZE:
         raise ValueError(f"size must be at most {_MAX_SIZE} pixels per side, got ({h}, {w})")
     return h, w
@@ -91,8 +91,8 @@ class View:
     def __init__(self, forward, up=(0.0, 0.0, 1.0), *, size=256, center=(0.0, 0.0, 0.0),
                  radius=_DEFAULT_RADIUS, projection="orthographic", zoom=1.0, fov=None,
                  distance=None):
-        f = _validate.vector3("forward", forward, unit=True)
-        up = _validate.vector3("up", up, unit=True)
+        f = validate.vector3("forward", forward, unit=True)
+        up = validate.vector3("up", up, unit=True)
         right = np.cross(f, up)
         if np.linalg.norm(right) < 1e-9:
             raise ValueError(
@@ -103,10 +103,10 @@ class View:
         self._basis = np.array([right, np.cross(right, f), f])
         self._basis.flags.writeable = False
         self.height, self.width = _image_size(size)
-        self.center = _validate.vector3("center", center)
-        self.radius = _validate.positive_number("radius", radius)
-        self.projection = _validate.choice("projection", projection, PROJECTIONS)
-        self.zoom = _validate.positive_number("zoom", zoom)
+        self.center = validate.vector3("center", center)
+        self.radius = validate.positive_number("radius", radius)
+        self.projection = validate.choice("projection", projection, PROJECTIONS)
+        self.zoom = validate.positive_number("zoom", zoom)
         if self.projection == "orthographic":
             if fov is not None or distance is not None:
                 raise ValueError("fov and distance apply to the perspective projection only")
@@ -116,7 +116,7 @@ class View:
         else:
             if distance is None:
                 distance = 4.0 * self.radius
-            self.distance = _validate.positive_number("distance", distance)
+            self.distance = validate.positive_number("distance", distance)
             if fov is None:
                 if self.distance <= self.radius:
                     raise ValueError(
@@ -124,7 +124,7 @@ class View:
                         f"(radius {self.radius:g}): give fov explicitly or move the eye out"
                     )
                 fov = 2.0 * math.degrees(math.asin(self.radius / self.distance))
-            self.fov = _validate.finite_number("fov", fov, low=0.0, high=180.0,
+            self.fov = validate.finite_number("fov", fov, low=0.0, high=180.0,
                                                low_open=True, high_open=True)
             half = math.tan(math.radians(self.fov) / 2.0) / self.zoom
             # Width of one pixel on the plane one world unit in front of the eye.
@@ -150,8 +150,8 @@ class View:
         >>> View.orbit(elevation=90, size=8).forward.round(12).tolist()
         [-0.0, -0.0, -1.0]
         """
-        a = math.radians(_validate.finite_number("azimuth", azimuth))
-        e = math.radians(_validate.finite_number("elevation", elevation))
+        a = math.radians(validate.finite_number("azimuth", azimuth))
+        e = math.radians(validate.finite_number("elevation", elevation))
         eye_dir = np.array([math.cos(e) * math.cos(a), math.cos(e) * math.sin(a), math.sin(e)])
         right = np.array([-math.sin(a), math.cos(a), 0.0])
         up = np.cross(right, -eye_dir)

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
-from vrlib import _validate
+from vrlib import validate
 
 __all__ = ["Volume", "MinMaxPyramid", "DEFAULT_EXTENT", "check_extent"]
 
@@ -230,8 +230,8 @@ class Volume:
         >>> pyr.maximum[0].tolist()[1][1], pyr.levels
         ([0.0, 1.0], 2)
         """
-        block = _validate.positive_int("block", block)
-        margin = _validate.positive_int("margin", margin, minimum=0)
+        block = validate.positive_int("block", block)
+        margin = validate.positive_int("margin", margin, minimum=0)
         return self.cached(("pyramid", block, margin),
                            lambda: _build_pyramid(self._data, block, margin))
 
@@ -252,7 +252,7 @@ class Volume:
         >>> np.shares_memory(vol.slices(1), vol.data)            # along y: a view
         True
         """
-        axis = _validate.choice("axis", axis, (0, 1, 2))
+        axis = validate.choice("axis", axis, (0, 1, 2))
         if axis == 2:
             return self._data
         if axis == 1:

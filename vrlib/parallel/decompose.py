@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vrlib import _validate
+from vrlib import validate
 
 __all__ = ["Brick", "KdTree", "grid_shape", "split", "ScreenTiles", "screen_tiles",
            "interleaved_owners", "SHAPES"]
@@ -130,8 +130,8 @@ def grid_shape(parts, shape="blocks"):
     >>> grid_shape(8, "shafts")
     (1, 2, 4)
     """
-    parts = _validate.positive_int("parts", parts)
-    axes = SHAPES[_validate.choice("shape", shape, tuple(SHAPES))]
+    parts = validate.positive_int("parts", parts)
+    axes = SHAPES[validate.choice("shape", shape, tuple(SHAPES))]
     best = None
     for factors in _factorisations(parts, len(axes)):
         spread = max(factors) / min(factors)
@@ -190,9 +190,9 @@ def split(cells, parts, *, shape="blocks", weights=None, grid=None):
     >>> tree.node[:2]                  # the first cut: z at cell 4
     (0, 4)
     """
-    cells = tuple(_validate.positive_int("cells", c) for c in cells)
-    parts = _validate.positive_int("parts", parts)
-    axes = SHAPES[_validate.choice("shape", shape, tuple(SHAPES))]
+    cells = tuple(validate.positive_int("cells", c) for c in cells)
+    parts = validate.positive_int("parts", parts)
+    axes = SHAPES[validate.choice("shape", shape, tuple(SHAPES))]
     if weights is not None:
         weights = np.asarray(weights, dtype=np.float64)
         if weights.shape != cells:
@@ -267,8 +267,8 @@ def interleaved_owners(bricks, ranks):
     >>> interleaved_owners(8, 4).tolist()
     [0, 1, 2, 3, 0, 1, 2, 3]
     """
-    bricks = _validate.positive_int("bricks", bricks)
-    ranks = _validate.positive_int("ranks", ranks)
+    bricks = validate.positive_int("bricks", bricks)
+    ranks = validate.positive_int("ranks", ranks)
     if ranks > bricks:
         raise ValueError(f"{ranks} ranks for {bricks} bricks: every rank needs at least one "
                          "brick (use at most as many ranks as bricks)")
@@ -320,10 +320,10 @@ def screen_tiles(height, width, nodes, *, layout="contiguous", tile=16):
     >>> screen_tiles(8, 8, 2, layout="interleaved", tile=4).owner.tolist()
     [[0, 1], [1, 0]]
     """
-    height = _validate.positive_int("height", height)
-    width = _validate.positive_int("width", width)
-    nodes = _validate.positive_int("nodes", nodes)
-    layout = _validate.choice("layout", layout, ("contiguous", "interleaved"))
+    height = validate.positive_int("height", height)
+    width = validate.positive_int("width", width)
+    nodes = validate.positive_int("nodes", nodes)
+    layout = validate.choice("layout", layout, ("contiguous", "interleaved"))
     if layout == "contiguous":
         if nodes > height * width:
             raise ValueError(f"{nodes} nodes for a {height} x {width} screen: at most one "
@@ -338,7 +338,7 @@ def screen_tiles(height, width, nodes, *, layout="contiguous", tile=16):
         cols = np.round(np.linspace(0, width, tx + 1)).astype(int)
         owner = np.arange(ty * tx).reshape(ty, tx)
     else:
-        tile = _validate.positive_int("tile", tile)
+        tile = validate.positive_int("tile", tile)
         rows = np.unique(np.minimum(np.arange(0, height + tile, tile), height))
         cols = np.unique(np.minimum(np.arange(0, width + tile, tile), width))
         i, j = np.meshgrid(np.arange(len(rows) - 1), np.arange(len(cols) - 1), indexing="ij")

@@ -12,7 +12,7 @@ import math
 
 import numpy as np
 
-from vrlib import _validate
+from vrlib import validate
 from vrlib.parallel.network import mesh_shape
 
 __all__ = ["projected_area", "box_rect_area", "object_frame", "binary_swap_frame",
@@ -170,7 +170,7 @@ def channel_loads(total, nodes, *, torus=False):
     >>> loads["bisection"], round(loads["mean"])
     (31250.0, 23438)
     """
-    _validate.positive_int("nodes", nodes)
+    validate.positive_int("nodes", nodes)
     x, y = mesh_shape(nodes)
     x_links = (x if torus else x - 1) if x > 1 else 0
     y_links = (y if torus else y - 1) if y > 1 else 0

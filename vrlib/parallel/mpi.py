@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from mpi4py import MPI
 
-from vrlib import _validate
+from vrlib import validate
 from vrlib.arguments import refuse_shading, render_arguments
 from vrlib.image import Image, RenderStats
 from vrlib.parallel.balance import BALANCE, visible_cells, visible_work, work_split
@@ -92,7 +92,7 @@ def _cast(data, first, brick_lo, brick_hi, lattice, view, filt, transfer, ds, va
 
 
 def _root(root, size):
-    root = _validate.positive_int("root", root, minimum=0)
+    root = validate.positive_int("root", root, minimum=0)
     if root >= size:
         raise ValueError(f"root must be a rank of the communicator, 0..{size - 1}, got {root}")
     return root
@@ -103,10 +103,10 @@ def _check(view, filter, transfer, step, compositing=None, balance=None,
     filt, transfer, step, _ = render_arguments(view, filter, transfer, step)
     refuse_shading(transfer, "the parallel renderer")
     if compositing is not None:
-        _validate.choice("compositing", compositing, tuple(COMPOSITORS))
+        validate.choice("compositing", compositing, tuple(COMPOSITORS))
     if balance is not None:
-        _validate.choice("balance", balance, BALANCE)
-        _validate.positive_int("bricks_per_rank", bricks_per_rank)
+        validate.choice("balance", balance, BALANCE)
+        validate.positive_int("bricks_per_rank", bricks_per_rank)
         if balance == "interleaved" and COMPOSITORS[compositing].one_brick_per_rank:
             raise ValueError(f"{compositing} compositing needs one convex brick per rank: use "
                              "balance='even' or 'work', or compositing='direct-send'")

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from vrlib import _validate
+from vrlib import validate
 
 __all__ = ["Network", "ChannelLoad", "mesh_shape"]
 
@@ -28,7 +28,7 @@ def mesh_shape(nodes):
     >>> mesh_shape(64), mesh_shape(128), mesh_shape(6)
     ((8, 8), (16, 8), (3, 2))
     """
-    nodes = _validate.positive_int("nodes", nodes)
+    nodes = validate.positive_int("nodes", nodes)
     y = max(f for f in range(1, math.isqrt(nodes) + 1) if nodes % f == 0)
     return nodes // y, y
 
@@ -118,8 +118,8 @@ class Network:
     """
 
     def __init__(self, columns, rows, *, torus=False):
-        self.columns = _validate.positive_int("columns", columns)
-        self.rows = _validate.positive_int("rows", rows)
+        self.columns = validate.positive_int("columns", columns)
+        self.rows = validate.positive_int("rows", rows)
         self.torus = bool(torus)
 
     @classmethod

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 from mpi4py import MPI
 
-from vrlib import _validate
+from vrlib import validate
 from vrlib.value_bounds import value_bounds
 
 __all__ = ["Lattice", "open_source", "ghost", "global_value_range"]
@@ -75,7 +75,7 @@ def open_source(source, shape, extent):
             raise ValueError("shape is required for an analytic field (samples per axis)")
         if isinstance(shape, int | np.integer):
             shape = (int(shape),) * 3
-        shape = tuple(_validate.positive_int("shape", n, minimum=2) for n in shape)
+        shape = tuple(validate.positive_int("shape", n, minimum=2) for n in shape)
         ext = np.asarray(source.bounds if extent is None else extent, float)
 
         def read(region):

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from vrlib import _validate
+from vrlib import validate
 
 __all__ = ["Partition", "TAXONOMY", "communication"]
 
@@ -48,14 +48,14 @@ class Partition:
     schedule: str = "static"
 
     def __post_init__(self):
-        _validate.choice("space", self.space, SPACES)
+        validate.choice("space", self.space, SPACES)
         shapes = ("tiles",) if self.space == "image" else ("slabs", "shafts", "blocks")
         if self.shape not in shapes:
             allowed = ", ".join(repr(s) for s in shapes)
             raise ValueError(f"shape must be one of {allowed} for {self.space} partitions, "
                              f"got {self.shape!r}")
-        _validate.choice("layout", self.layout, LAYOUTS)
-        _validate.choice("schedule", self.schedule, SCHEDULES)
+        validate.choice("layout", self.layout, LAYOUTS)
+        validate.choice("schedule", self.schedule, SCHEDULES)
 
     @property
     def name(self):

@@ -1,4 +1,4 @@
-"""Argument checks shared by the public API.
+"""Argument checks shared by the public API (vrlib's and data_gen's).
 
 Every check raises a ``ValueError`` (or ``TypeError`` for a wrong kind of object) whose message
 names the parameter, what was given, and what is allowed.
