@@ -1,22 +1,18 @@
 """Output of the benchmark scripts: Markdown tables on stdout, JSON records under build/."""
 
 import json
-import time
 from pathlib import Path
 
 from vrlib.atomic import atomic_path
+from vrlib.cost import measure
 
 ROOT = Path(__file__).resolve().parent.parent
 
 
 def best_of(fn, repeats=3):
-    """``(seconds, result)`` of the fastest of ``repeats`` calls of ``fn``."""
-    runs = []
-    for _ in range(repeats):
-        start = time.perf_counter()
-        result = fn()
-        runs.append((time.perf_counter() - start, result))
-    return min(runs, key=lambda run: run[0])
+    """``(seconds, result)``: the fastest of ``repeats`` calls of ``fn``, timed by
+    :func:`vrlib.cost.measure` (without its warm-up: the scripts warm up where they must)."""
+    return measure(fn, repeats=repeats, warmup=False)
 
 
 def markdown(header, rows):
