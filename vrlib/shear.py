@@ -185,6 +185,15 @@ def _passes(volume, view, plan, filt, count, dtype):
     return v2, first2, last2
 
 
+def _first_passes(volume, view, filt, step, dtype):
+    """What both methods do first: the ray step in world units, the plan, and passes 1 and 2
+    (:func:`_passes`) with their counts."""
+    ds = step * float(volume.spacing.min())
+    plan = plan_shear(volume, view, ds)
+    count = {}
+    return ds, plan, count, _passes(volume, view, plan, filt, count, dtype)
+
+
 def _stats(volume, taps, count, composited, seconds, largest):
     resampled = count["pass1"] + count["pass2"] + count.get("pass3", 0)
     return RenderStats(samples=resampled + composited,
@@ -224,10 +233,7 @@ def render_shear3(volume, view, *, filt, transfer, step, early_termination,
     _check(view, transfer)
     dtype = _intermediate(intermediate, volume)
     start = time.perf_counter()
-    ds = step * float(volume.spacing.min())
-    plan = plan_shear(volume, view, ds)
-    count = {}
-    v2, first2, last2 = _passes(volume, view, plan, filt, count, dtype)
+    ds, plan, count, (v2, first2, last2) = _first_passes(volume, view, filt, step, dtype)
     v3 = np.zeros((plan.depth_samples, view.height, view.width), dtype)
     # Pass 3 lines (Y, X) run along w: first2/last2 are indexed [w, X] over Y.
     lo, hi = _filled(first2.transpose(1, 0), last2.transpose(1, 0), view.height)  # [X, Y]
@@ -255,10 +261,7 @@ def render_shear2(volume, view, *, filt, transfer, step, early_termination,
     _check(view, transfer)
     dtype = _intermediate(intermediate, volume)
     start = time.perf_counter()
-    ds = step * float(volume.spacing.min())
-    plan = plan_shear(volume, view, ds)
-    count = {}
-    v2, _, _ = _passes(volume, view, plan, filt, count, dtype)
+    ds, plan, count, (v2, _, _) = _first_passes(volume, view, filt, step, dtype)
     length = abs(plan.i) * ds  # world distance between slices along a ray
     tables = transfer.segment_table(length, *reconstructed_range(volume, filt))
     m = plan.matrix
