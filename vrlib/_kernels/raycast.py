@@ -88,6 +88,7 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, camera, heigh
     coarse_counts = np.array(coarse.shape)
     ntab = alpha_tab.shape[0]
     inv = 1.0 / spacing
+    plain = fkind == TENT and grey and not shade and block == 0
     for it in prange(order.shape[0]):
         tile_id = order[it]
         row0 = (tile_id // tiles_across) * tile_h
@@ -127,100 +128,124 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, camera, heigh
             by = d[1] * inv[1]
             bz = d[2] * inv[2]
             k = math.ceil(t_in / ds - 0.5)
-            # Samples before t_check lie in a block already found not empty: no check needed
-            # (a sample that rounding puts in an empty block anyway adds exactly nothing).
-            t_check = -math.inf if block > 0 else math.inf
-            while True:
-                t = (k + 0.5) * ds
-                if t >= t_out:
-                    break
-                ux = ax + t * bx
-                uy = ay + t * by
-                uz = az + t * bz
-                if t >= t_check and not _is_empty(empty, block, ux, uy, uz):
-                    t_check = _exit(ax, ay, az, bx, by, bz, block, fine_counts, ux, uy, uz)
-                elif t >= t_check:
-                    # Jump past the largest empty block here, then step back over any sample
-                    # that rounding placed in a block that is not empty: the image is unchanged.
-                    if _is_empty(coarse, 4 * block, ux, uy, uz):
-                        t_exit = _exit(ax, ay, az, bx, by, bz, 4 * block, coarse_counts,
-                                       ux, uy, uz)
+            if plain:
+                # The common case, its loop stripped: tent filter, white unshaded emission,
+                # nothing to skip. The same arithmetic as the general loop below.
+                while True:
+                    t = (k + 0.5) * ds
+                    if t >= t_out:
+                        break
+                    value = trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ax + t * bx,
+                                      ay + t * by, az + t * bz)
+                    taken += 1
+                    k += 1
+                    i, w = lookup((value - tstart) * tinv, ntab)
+                    alpha = alpha_tab[i] + w * (alpha_tab[i + 1] - alpha_tab[i])
+                    if not alpha > 0.0:
+                        continue
+                    remaining = 1.0 - acc_a
+                    acc_r += remaining * alpha
+                    acc_a += remaining * alpha
+                    if acc_a >= threshold:
+                        break
+                acc_g = acc_r
+                acc_b = acc_r
+            else:
+                # Samples before t_check lie in a block already found not empty: no check needed
+                # (a sample that rounding puts in an empty block anyway adds exactly nothing).
+                t_check = -math.inf if block > 0 else math.inf
+                while True:
+                    t = (k + 0.5) * ds
+                    if t >= t_out:
+                        break
+                    ux = ax + t * bx
+                    uy = ay + t * by
+                    uz = az + t * bz
+                    if t >= t_check and not _is_empty(empty, block, ux, uy, uz):
+                        t_check = _exit(ax, ay, az, bx, by, bz, block, fine_counts, ux, uy, uz)
+                    elif t >= t_check:
+                        # Jump past the largest empty block here, then step back over any
+                        # sample that rounding placed in a block that is not empty: the image
+                        # is unchanged.
+                        if _is_empty(coarse, 4 * block, ux, uy, uz):
+                            t_exit = _exit(ax, ay, az, bx, by, bz, 4 * block, coarse_counts,
+                                           ux, uy, uz)
+                        else:
+                            t_exit = _exit(ax, ay, az, bx, by, bz, block, fine_counts, ux, uy, uz)
+                        k_next = max(math.ceil(t_exit / ds - 0.5), k + 1)
+                        while k_next > k + 1:
+                            tb = (k_next - 0.5) * ds
+                            if _is_empty(empty, block, ax + tb * bx, ay + tb * by, az + tb * bz):
+                                break
+                            k_next -= 1
+                        k = k_next
+                        continue
+                    # The two common filters unrolled, the others through the general loop.
+                    if fkind == TENT:
+                        value = trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz)
+                    elif fkind == CUBIC:
+                        value = tricubic(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz,
+                                         fp0, fp1)
+                    elif ntaps == 4:
+                        value = separable4(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz,
+                                           fkind, fp0, fp1, fp2, radius)
                     else:
-                        t_exit = _exit(ax, ay, az, bx, by, bz, block, fine_counts, ux, uy, uz)
-                    k_next = max(math.ceil(t_exit / ds - 0.5), k + 1)
-                    while k_next > k + 1:
-                        tb = (k_next - 0.5) * ds
-                        if _is_empty(empty, block, ax + tb * bx, ay + tb * by, az + tb * bz):
-                            break
-                        k_next -= 1
-                    k = k_next
-                    continue
-                # The two common filters unrolled, the others through the general loop.
-                if fkind == TENT:
-                    value = trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz)
-                elif fkind == CUBIC:
-                    value = tricubic(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz,
-                                     fp0, fp1)
-                elif ntaps == 4:
-                    value = separable4(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz,
-                                       fkind, fp0, fp1, fp2, radius)
-                else:
-                    value = reconstruct(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1, fp2,
-                                        radius, ntaps, wx, wy, wz)
-                taken += 1
-                k += 1
-                # Classify: segment opacity 1 - exp(-density ds) (eq 1.4) and colour E alpha
-                # (eq 1.9), from the table.
-                i, w = lookup((value - tstart) * tinv, ntab)
-                alpha = alpha_tab[i] + w * (alpha_tab[i + 1] - alpha_tab[i])
-                if not alpha > 0.0:
-                    continue  # a transparent segment adds exactly nothing
-                if grey:
-                    cr = cg = cb = alpha  # white emission, no shading: colour = opacity
-                elif shade:
-                    gx_, gy_, gz_ = gradient(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1,
-                                             fp2, radius, ntaps, wx, wy, wz, dx, dy, dz)
-                    gx_ *= inv[0]
-                    gy_ *= inv[1]
-                    gz_ *= inv[2]
-                    norm = math.sqrt(gx_ * gx_ + gy_ * gy_ + gz_ * gz_)
-                    if headlight:
-                        lx, ly, lz = -d[0], -d[1], -d[2]
+                        value = reconstruct(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1, fp2,
+                                            radius, ntaps, wx, wy, wz)
+                    taken += 1
+                    k += 1
+                    # Classify: segment opacity 1 - exp(-density ds) (eq 1.4) and colour E alpha
+                    # (eq 1.9), from the table.
+                    i, w = lookup((value - tstart) * tinv, ntab)
+                    alpha = alpha_tab[i] + w * (alpha_tab[i + 1] - alpha_tab[i])
+                    if not alpha > 0.0:
+                        continue  # a transparent segment adds exactly nothing
+                    if grey:
+                        cr = cg = cb = alpha  # white emission, no shading: colour = opacity
+                    elif shade:
+                        gx_, gy_, gz_ = gradient(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1,
+                                                 fp2, radius, ntaps, wx, wy, wz, dx, dy, dz)
+                        gx_ *= inv[0]
+                        gy_ *= inv[1]
+                        gz_ *= inv[2]
+                        norm = math.sqrt(gx_ * gx_ + gy_ * gy_ + gz_ * gz_)
+                        if headlight:
+                            lx, ly, lz = -d[0], -d[1], -d[2]
+                        else:
+                            lx, ly, lz = light[0], light[1], light[2]
+                        # Half-vector of the light and the direction to the eye (-d).
+                        hx, hy, hz = lx - d[0], ly - d[1], lz - d[2]
+                        hn = math.sqrt(hx * hx + hy * hy + hz * hz)
+                        if hn > 0.0:
+                            hx, hy, hz = hx / hn, hy / hn, hz / hn
+                        else:
+                            hx, hy, hz = lx, ly, lz
+                        if norm > 0.0:
+                            ndotl = abs(gx_ * lx + gy_ * ly + gz_ * lz) / norm
+                            ndoth = abs(gx_ * hx + gy_ * hy + gz_ * hz) / norm
+                        else:
+                            ndotl = 1.0
+                            ndoth = 1.0
+                        factor = ka + kd * ndotl
+                        spec = ks * ndoth**shininess
+                        er = emit_tab[i, 0] + w * (emit_tab[i + 1, 0] - emit_tab[i, 0])
+                        eg = emit_tab[i, 1] + w * (emit_tab[i + 1, 1] - emit_tab[i, 1])
+                        eb = emit_tab[i, 2] + w * (emit_tab[i + 1, 2] - emit_tab[i, 2])
+                        cr = (er * factor + spec) * alpha
+                        cg = (eg * factor + spec) * alpha
+                        cb = (eb * factor + spec) * alpha
                     else:
-                        lx, ly, lz = light[0], light[1], light[2]
-                    # Half-vector of the light and the direction to the eye (-d).
-                    hx, hy, hz = lx - d[0], ly - d[1], lz - d[2]
-                    hn = math.sqrt(hx * hx + hy * hy + hz * hz)
-                    if hn > 0.0:
-                        hx, hy, hz = hx / hn, hy / hn, hz / hn
-                    else:
-                        hx, hy, hz = lx, ly, lz
-                    if norm > 0.0:
-                        ndotl = abs(gx_ * lx + gy_ * ly + gz_ * lz) / norm
-                        ndoth = abs(gx_ * hx + gy_ * hy + gz_ * hz) / norm
-                    else:
-                        ndotl = 1.0
-                        ndoth = 1.0
-                    factor = ka + kd * ndotl
-                    spec = ks * ndoth**shininess
-                    er = emit_tab[i, 0] + w * (emit_tab[i + 1, 0] - emit_tab[i, 0])
-                    eg = emit_tab[i, 1] + w * (emit_tab[i + 1, 1] - emit_tab[i, 1])
-                    eb = emit_tab[i, 2] + w * (emit_tab[i + 1, 2] - emit_tab[i, 2])
-                    cr = (er * factor + spec) * alpha
-                    cg = (eg * factor + spec) * alpha
-                    cb = (eb * factor + spec) * alpha
-                else:
-                    cr = color_tab[i, 0] + w * (color_tab[i + 1, 0] - color_tab[i, 0])
-                    cg = color_tab[i, 1] + w * (color_tab[i + 1, 1] - color_tab[i, 1])
-                    cb = color_tab[i, 2] + w * (color_tab[i + 1, 2] - color_tab[i, 2])
-                # Front-to-back over, eqs 1.7-1.8.
-                remaining = 1.0 - acc_a
-                acc_r += remaining * cr
-                acc_g += remaining * cg
-                acc_b += remaining * cb
-                acc_a += remaining * alpha
-                if acc_a >= threshold:
-                    break
+                        cr = color_tab[i, 0] + w * (color_tab[i + 1, 0] - color_tab[i, 0])
+                        cg = color_tab[i, 1] + w * (color_tab[i + 1, 1] - color_tab[i, 1])
+                        cb = color_tab[i, 2] + w * (color_tab[i + 1, 2] - color_tab[i, 2])
+                    # Front-to-back over, eqs 1.7-1.8.
+                    remaining = 1.0 - acc_a
+                    acc_r += remaining * cr
+                    acc_g += remaining * cg
+                    acc_b += remaining * cb
+                    acc_a += remaining * alpha
+                    if acc_a >= threshold:
+                        break
             out[r, c, 0] = acc_r
             out[r, c, 1] = acc_g
             out[r, c, 2] = acc_b
