@@ -17,9 +17,10 @@ from vrlib.cost import machine, measure
 
 N, SIZE = by_profile(64, 128), by_profile(256, 512)
 FILTERS = list(vrlib.filters.STANDARD)
-CONFIGS = ([("raycast", s) for s in (0.25, 0.5, 1.0)] + [("splat", None)]
-           + [("shear3", s) for s in (0.5, 1.0)] + [("shear2", s) for s in (0.5, 1.0)]
-           + [("shearwarp", None)])
+# Steps tried per method; a method not named here (one whose samples along a ray are not set
+# by ``step``, or a new one) renders at its default.
+STEPS = {"raycast": (0.25, 0.5, 1.0), "shear3": (0.5, 1.0), "shear2": (0.5, 1.0)}
+CONFIGS = [(method, step) for method in vrlib.METHODS for step in STEPS.get(method, (None,))]
 
 
 def pareto(points):
