@@ -51,6 +51,7 @@ __all__ = [
 
 #: Largest filter radius (voxels) the renderers take: the kernels' tap limit over two.
 MAX_RADIUS = _k.MAX_TAPS / 2
+_cubic_coefficients = getattr(_k.cubic_coefficients, "py_func", _k.cubic_coefficients)
 
 
 class Filter:
@@ -278,8 +279,9 @@ class MitchellNetravali(_Piecewise):
         self.B = validate.finite_number("B", B)
         self.C = validate.finite_number("C", C)
         self.name = name
-        # The two cubic pieces (the kernels' one definition), divided by 6, ascending powers.
-        near, far = _k.cubic_coefficients(self.B, self.C)
+        # The two cubic pieces (the kernels' one definition, run as plain Python: building a
+        # filter compiles nothing), divided by 6, ascending powers.
+        near, far = _cubic_coefficients(self.B, self.C)
         self.pieces = (
             (0.0, 1.0, tuple(v / 6 for v in near)),
             (1.0, 2.0, tuple(v / 6 for v in far)),
