@@ -28,7 +28,7 @@ def test_trilinear_rays_sum_the_trilinear_samples(dtype):
     rays never leave the brick, so no clamping is involved)."""
     brick, starts, direction = rays_and_brick(dtype)
     out = np.empty(len(starts))
-    kernels.trilinear_rays(brick, starts, direction, roofline.STEPS, out)
+    kernels.sample_rays(brick, starts, direction, roofline.STEPS, False, 0.0, 0.5, out)
     points = points_along(starts, direction)
     assert points.min() >= 1.0 and points.max() <= roofline.BRICK - 3.0
     expected = reconstruct_naive(Volume(brick.astype(np.float64)), make_filter("trilinear"),
@@ -40,7 +40,7 @@ def test_trilinear_rays_sum_the_trilinear_samples(dtype):
 def test_tricubic_rays_sum_the_catmull_rom_samples():
     brick, starts, direction = rays_and_brick(np.float32)
     out = np.empty(len(starts))
-    kernels.tricubic_rays(brick, starts, direction, roofline.STEPS, 0.0, 0.5, out)
+    kernels.sample_rays(brick, starts, direction, roofline.STEPS, True, 0.0, 0.5, out)
     points = points_along(starts, direction)
     expected = reconstruct_naive(Volume(brick.astype(np.float64)), make_filter("catmull-rom"),
                                  points.reshape(-1, 3)).reshape(points.shape[:2]).sum(axis=1)

@@ -87,12 +87,10 @@ def measure(*, threads=None, repeats=5, elements=1 << 24, rays=1 << 16):
         samples = rays * STEPS
         for dtype in (np.float32, np.float64):
             brick = rng.uniform(0.0, 1.0, (BRICK,) * 3).astype(dtype)
-            seconds, _ = _time(lambda brick=brick: _kernel.trilinear_rays(
-                brick, starts, direction, STEPS, sums), repeats=repeats)
-            out[f"trilinear_{np.dtype(dtype).name}"] = samples / seconds
-            seconds, _ = _time(lambda brick=brick: _kernel.tricubic_rays(
-                brick, starts, direction, STEPS, 0.0, 0.5, sums), repeats=repeats)
-            out[f"tricubic_{np.dtype(dtype).name}"] = samples / seconds
+            for name, cubic in (("trilinear", False), ("tricubic", True)):
+                seconds, _ = _time(lambda brick=brick, cubic=cubic: _kernel.sample_rays(
+                    brick, starts, direction, STEPS, cubic, 0.0, 0.5, sums), repeats=repeats)
+                out[f"{name}_{np.dtype(dtype).name}"] = samples / seconds
         out["threads"] = numba.get_num_threads()
         return out
     finally:

@@ -104,6 +104,13 @@ def trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz):
         d101 = flat[z1 + y0 + x1]
         d110 = flat[z1 + y1 + x0]
         d111 = flat[z1 + y1 + x1]
+    return lerp_corners(d000, d001, d010, d011, d100, d101, d110, d111, tx, ty, tz)
+
+
+@jit
+def lerp_corners(d000, d001, d010, d011, d100, d101, d110, d111, tx, ty, tz):
+    """Trilinear interpolation of a cell's corners ``d_zyx`` at fractions ``(tx, ty, tz)``:
+    along x, then y, then z."""
     c00 = d000 + tx * (d001 - d000)
     c01 = d010 + tx * (d011 - d010)
     c10 = d100 + tx * (d101 - d100)
@@ -114,7 +121,7 @@ def trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz):
 
 
 @jit
-def _cubic_weights(t, b, c):
+def cubic_weights(t, b, c):
     """Mitchell-Netravali weights of the taps at offsets -1, 0, 1, 2 from a point at fraction
     ``t`` in [0, 1) past tap 0 (distances 1 + t, t, 1 - t, 2 - t)."""
     near, far = cubic_coefficients(b, c)
@@ -130,8 +137,8 @@ def tricubic(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz, b, c):
     iy = int(math.floor(uy))
     iz = int(math.floor(uz))
     return four_taps(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ix - 1, iy - 1, iz - 1,
-                     _cubic_weights(ux - ix, b, c), _cubic_weights(uy - iy, b, c),
-                     _cubic_weights(uz - iz, b, c))
+                     cubic_weights(ux - ix, b, c), cubic_weights(uy - iy, b, c),
+                     cubic_weights(uz - iz, b, c))
 
 
 @jit

@@ -31,6 +31,7 @@ from mpi4py import MPI
 from vrlib import validate
 from vrlib.arguments import refuse_shading, render_arguments
 from vrlib.image import Image, RenderStats
+from vrlib.parallel import rects
 from vrlib.parallel.balance import BALANCE, visible_cells, visible_work, work_split
 from vrlib.parallel.composite import COMPOSITORS, HEADER, gather_to_root
 from vrlib.parallel.decompose import interleaved_owners, screen_tiles, split
@@ -330,7 +331,7 @@ def render_image(comm, source, view, *, shape=None, extent=None, filter="triline
                 spacing=lattice.spacing, box=lattice.box((0, 0, 0), lattice.cells), view=view,
                 filt=filt, transfer=transfer, ds=ds, value_range=value_range,
                 early_termination=1.0, skip=(skip_grid, coarsen(skip_grid), BLOCK, mask))
-            pixels = rgba[tile[0]:tile[1], tile[2]:tile[3]].copy()
+            pixels = rects.pixels(rgba, tile)
         render_s = time.perf_counter() - start
     rgba = gather_to_root(comm, tile, pixels, view.shape, root, sent)
     stats = {"rank": rank, "bricks": 1, "samples": int(samples), "render_s": render_s,
