@@ -9,8 +9,6 @@ report quotes to ``build/results/ch04_cost/roofline_fractions.json``.
 import vrlib
 from chapters.common import figure_path, read_json, result_path, write_csv, write_json
 
-CEILING = {2: "trilinear", 4: "tricubic"}  # taps per axis -> ceiling
-
 
 def main():
     limits = read_json(result_path(__file__, "roofline.json"))
@@ -22,7 +20,7 @@ def main():
         threads = r["backend"].split()[1]
         if threads not in limits["limits"]:
             continue
-        kind = CEILING[vrlib.make_filter(r["filter"]).taps]
+        kind = "trilinear" if vrlib.make_filter(r["filter"]).taps <= 2 else "tricubic"
         ceiling = limits["limits"][threads][f"{kind}_float64"]
         rate = r["points"] / r["seconds"]
         fractions.append({"scene": r["scene"], "filter": r["filter"], "threads": int(threads),
