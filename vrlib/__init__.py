@@ -18,11 +18,12 @@ The public API is the list in ``__all__``.
 """
 
 from vrlib import bounds, compositing, cost, filters, metrics
+from vrlib.classified import ClassifiedVolume, classify
 from vrlib.filters import FILTERS, make_filter
 from vrlib.image import Image, RenderStats
 from vrlib.reference import render_reference
 from vrlib.render import METHODS, reference_image, render
-from vrlib.transfer import Glow, LookupTransfer, Phong, TransferFunction
+from vrlib.transfer import GradientOpacity, Glow, LookupTransfer, Phong, TransferFunction
 from vrlib.view import View
 from vrlib.volume import Volume
 
@@ -33,11 +34,14 @@ __all__ = [
     "render_reference",
     "reference_image",
     "METHODS",
+    "classify",
+    "ClassifiedVolume",
     "Volume",
     "View",
     "Glow",
     "LookupTransfer",
     "Phong",
+    "GradientOpacity",
     "TransferFunction",
     "Image",
     "RenderStats",

@@ -1,11 +1,41 @@
 """How parallel loops share out their work: each thread of a numba ``prange`` takes one
-contiguous run of the iteration space, so the order of the items decides the balance."""
+contiguous run of the iteration space, so the order of the items decides the balance; and how
+many threads they run on."""
 
 from __future__ import annotations
 
+import contextlib
+import numbers
+
+import numba
 import numpy as np
 
-__all__ = ["balanced_order"]
+__all__ = ["balanced_order", "thread_count"]
+
+
+@contextlib.contextmanager
+def thread_count(threads):
+    """Run the block on ``threads`` numba threads (None: numba's setting), then restore it.
+
+    Raises
+    ------
+    TypeError, ValueError
+        ``threads`` not an integer, or outside 1 .. ``NUMBA_NUM_THREADS``.
+    """
+    if threads is None:
+        yield
+        return
+    if isinstance(threads, bool) or not isinstance(threads, numbers.Integral):
+        raise TypeError(f"threads must be an integer, got {threads!r}")
+    limit = numba.config.NUMBA_NUM_THREADS
+    if not 1 <= threads <= limit:
+        raise ValueError(f"threads must be between 1 and {limit}, got {threads}")
+    previous = numba.get_num_threads()
+    numba.set_num_threads(int(threads))
+    try:
+        yield
+    finally:
+        numba.set_num_threads(previous)
 
 
 def balanced_order(costs, parts):

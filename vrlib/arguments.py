@@ -13,7 +13,7 @@ from vrlib.filters import check_radius, make_filter
 from vrlib.transfer import Glow, TransferFunction
 from vrlib.view import View
 
-__all__ = ["check_view", "check_transfer", "render_arguments", "refuse_shading"]
+__all__ = ["check_view", "check_transfer", "render_arguments", "refuse_gradients"]
 
 
 def check_view(view):
@@ -65,8 +65,12 @@ def render_arguments(view, filter, transfer, step, early_termination=1.0):
     return filt, transfer, step, early_termination
 
 
-def refuse_shading(transfer, who):
-    """Refuse a shaded transfer function where ``who`` (a renderer) cannot shade."""
+def refuse_gradients(transfer, who):
+    """Refuse a transfer function that needs gradients (shading, gradient opacity) where
+    ``who`` (a renderer) reconstructs values only."""
     if transfer.shading is not None:
         raise ValueError(f"{who} does not shade (it reconstructs no gradients); use "
-                         f"method='raycast' for shaded images")
+                         f"method='raycast' (or vrlib.classify for shear-warp) for shaded images")
+    if transfer.gradient_opacity is not None:
+        raise ValueError(f"{who} reconstructs no gradients, so it cannot classify by gradient "
+                         f"magnitude (gradient_opacity); use method='raycast' or vrlib.classify")

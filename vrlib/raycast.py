@@ -70,7 +70,7 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
     )
     stats = RenderStats(
         samples=taken,
-        operations=taken * operations_per_sample(filt, shading=transfer.shading is not None),
+        operations=taken * operations_per_sample(filt, shading=transfer.needs_gradient),
         bytes=int(volume.data.nbytes + rgba.nbytes),
         seconds=time.perf_counter() - start,
     )
@@ -114,6 +114,9 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
     if skip is None:
         skip = (np.zeros((1, 1, 1), dtype=bool), np.zeros((1, 1, 1), dtype=bool), 0,
                 np.ones(view.shape, dtype=bool))
+    ramp = transfer.gradient_opacity
+    by_gradient = (np.zeros(2), np.zeros(2), False) if ramp is None else (
+        ramp.magnitudes, ramp.factors, True)
     grey = shading is None and bool(np.all(tables[4] == 1.0))  # colour equals opacity
     out = np.empty(view.shape + (4,))
     rows, cols = -(-view.height // TILE[0]), -(-view.width // TILE[1])
@@ -129,7 +132,8 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
         np.asarray(origin, np.float64), np.asarray(spacing, np.float64),
         np.asarray(box[0], np.float64), np.asarray(box[1], np.float64), view.packed(),
         view.height, view.width,
-        ds, *filt.code, filt.radius, filt.taps, *tables, *lighting, early_termination, *skip,
+        ds, *filt.code, filt.radius, filt.taps, *tables, *lighting, *by_gradient,
+        early_termination, *skip,
         *TILE, balanced_order(costs, numba.get_num_threads()), out, samples, grey,
     )
     np.clip(out[..., 3], 0.0, 1.0, out=out[..., 3])

@@ -82,8 +82,11 @@ class _Segments:
         omega = self.transfer.opacity_density(values)
         emit = self.transfer.emission(values)
         shading = self.transfer.shading
+        ramp = self.transfer.gradient_opacity
+        grad = self.field.gradient(points) if self.transfer.needs_gradient else None
+        if ramp is not None:
+            omega = omega * ramp.factor(np.linalg.norm(grad, axis=-1))
         if shading is not None:
-            grad = self.field.gradient(points)
             view_dir = -self.directions[ray]
             factor = np.empty(values.shape)
             spec = np.empty(values.shape)

@@ -2,13 +2,10 @@
 
 from __future__ import annotations
 
-import contextlib
 import inspect
-import numbers
-
-import numba
 
 from vrlib import validate
+from vrlib._scheduling import thread_count
 from vrlib.arguments import render_arguments
 from vrlib.raycast import render_raycast
 from vrlib.reference import render_reference
@@ -43,19 +40,6 @@ def method_options(method):
     params = inspect.signature(METHODS[method]).parameters.values()
     return {p.name: p.default for p in params
             if p.kind is p.KEYWORD_ONLY and p.name not in _COMMON}
-
-
-@contextlib.contextmanager
-def _threads(count):
-    if count is None:
-        yield
-        return
-    previous = numba.get_num_threads()
-    numba.set_num_threads(count)
-    try:
-        yield
-    finally:
-        numba.set_num_threads(previous)
 
 
 def render(volume, view, *, method="raycast", filter="trilinear", transfer=None, step=0.5,
@@ -115,18 +99,12 @@ def render(volume, view, *, method="raycast", filter="trilinear", transfer=None,
         raise TypeError(
             f"empty_space_skipping must be True or False, got {empty_space_skipping!r}"
         )
-    if threads is not None:
-        if isinstance(threads, bool) or not isinstance(threads, numbers.Integral):
-            raise TypeError(f"threads must be an integer, got {threads!r}")
-        limit = numba.config.NUMBA_NUM_THREADS
-        if not 1 <= threads <= limit:
-            raise ValueError(f"threads must be between 1 and {limit}, got {threads}")
     allowed = method_options(method)
     unknown = sorted(set(options) - set(allowed))
     if unknown:
         known = ", ".join(allowed) or "none"
         raise TypeError(f"method {method!r} takes no option {unknown[0]!r}; its options: {known}")
-    with _threads(threads):
+    with thread_count(threads):
         return METHODS[method](volume, view, filt=filt, transfer=transfer, step=step,
                                early_termination=early_termination,
                                empty_space_skipping=empty_space_skipping, **options)

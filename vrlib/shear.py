@@ -29,7 +29,7 @@ import numpy as np
 
 from vrlib import validate
 from vrlib._kernels import shear as _kernel
-from vrlib.arguments import refuse_shading
+from vrlib.arguments import refuse_gradients
 from vrlib.image import Image, RenderStats
 from vrlib.value_bounds import reconstructed_range
 
@@ -129,7 +129,7 @@ def plan_shear(volume, view, ds):
 
 def _check(view, transfer):
     """Refuse what three- and two-pass shearing cannot render."""
-    refuse_shading(transfer, "volume shearing")
+    refuse_gradients(transfer, "volume shearing")
     if view.is_perspective:
         raise ValueError("three- and two-pass shearing factor an affine view: orthographic "
                          "only; use method='shearwarp' or 'raycast' for perspective")

@@ -18,13 +18,13 @@ import numpy as np
 
 from vrlib import validate
 from vrlib._kernels import shear as _kernel
-from vrlib.arguments import refuse_shading
+from vrlib.arguments import refuse_gradients
 from vrlib.image import Image, RenderStats
 from vrlib.skipping import transparent_runs
 from vrlib.value_bounds import lattice_sums, reconstructed_range
 from vrlib.view import principal_axis
 
-__all__ = ["render_shearwarp", "transparent_bound"]
+__all__ = ["render_shearwarp", "transparent_bound", "intermediate_plane", "warp_homography"]
 
 
 def transparent_bound(transfer, low, high, length, min_opacity):
@@ -47,7 +47,7 @@ def transparent_bound(transfer, low, high, length, min_opacity):
     return float(start + (visible[0] - 1) / inv)
 
 
-def _intermediate_plane(volume, view, axis, ascending):
+def intermediate_plane(volume, view, axis, ascending):
     """Shear-warp's factorisation: the plane of the front slice and, per slice, the map from
     intermediate pixels to slice samples (:func:`vrlib._kernels.shear.shear_slices`).
 
@@ -90,7 +90,7 @@ def _intermediate_plane(volume, view, axis, ascending):
     return scale, di, dj, -low, (int(height), int(width)), kf, rays
 
 
-def _warp_homography(view, volume, axis, plane, offsets):
+def warp_homography(view, volume, axis, plane, offsets):
     """``H`` with ``(A, B, D) = H @ (column, row, 1)``: the pixel's ray meets the plane
     ``x[axis] = plane`` at intermediate coordinates ``(A / D, B / D)`` (``D > 0`` where it meets
     it in front of the eye). Affine for orthographic views (``D = 1``), projective for
@@ -140,11 +140,11 @@ def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
     """
     min_opacity = validate.finite_number("min_opacity", min_opacity, low=0.0, high=1.0,
                                           high_open=True)
-    refuse_shading(transfer, "shear-warp")
+    refuse_gradients(transfer, "shear-warp")
     ntaps = filt.taps
     start = time.perf_counter()
     axis, ascending = principal_axis(view, volume)
-    scale, di, dj, (oi, oj), (height, width), kf, rays = _intermediate_plane(
+    scale, di, dj, (oi, oj), (height, width), kf, rays = intermediate_plane(
         volume, view, axis, ascending)
     q_axis, p_axis = [a for a in range(3) if a != axis]
     slices = volume.slices(axis)  # [k, j, i]: j along p_axis, i along q_axis
@@ -178,7 +178,7 @@ def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
     # The warp: where each pixel's ray meets the front slice, in intermediate coordinates.
     plane = volume.origin[axis] + kf * h[axis]
     out = np.empty(view.shape + (4,))
-    _kernel.warp(inter, _warp_homography(view, volume, axis, plane, (oi, oj)), out)
+    _kernel.warp(inter, warp_homography(view, volume, axis, plane, (oi, oj)), out)
     resampled = int(counts.sum())
     stats = RenderStats(samples=resampled, operations=resampled * (2 * ntaps**2 + 12)
                         + out.size * 8, bytes=int(volume.data.nbytes + inter.nbytes + out.nbytes),

@@ -24,7 +24,7 @@ import numpy as np
 from vrlib import validate
 from vrlib._kernels import splat as _kernel
 from vrlib._scheduling import balanced_order
-from vrlib.arguments import refuse_shading
+from vrlib.arguments import refuse_gradients
 from vrlib.footprint import RADIAL, footprint
 from vrlib.image import Image, RenderStats
 from vrlib.value_bounds import reconstructed_range
@@ -103,7 +103,7 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
         Footprint table entries per axis (:func:`vrlib.footprint.footprint`).
     """
     validate.choice("mode", mode, MODES)
-    refuse_shading(transfer, "splatting")
+    refuse_gradients(transfer, "splatting")
     axis, ascending = principal_axis(view, volume)
     extent = volume.extent
     if view.is_perspective and extent[axis, 0] <= view.eye[axis] <= extent[axis, 1]:

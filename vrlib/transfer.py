@@ -8,6 +8,8 @@ The rendering model (eqs 1.2-1.5) needs, at every point, a differential opacity
   "the data glows in proportion to its value", so every image error comes from reconstruction.
 * :class:`LookupTransfer` tabulates density and colour for general use.
 * :class:`Phong` adds gradient shading to either.
+* :class:`GradientOpacity` makes the opacity depend on the gradient magnitude too (Levoy 1988):
+  a transfer function of two variables, ``Omega = O(F) g(|grad F|)``.
 """
 
 from __future__ import annotations
@@ -16,7 +18,7 @@ import numpy as np
 
 from vrlib import validate
 
-__all__ = ["TransferFunction", "Glow", "LookupTransfer", "Phong"]
+__all__ = ["TransferFunction", "Glow", "LookupTransfer", "Phong", "GradientOpacity"]
 
 
 class Phong:
@@ -82,10 +84,65 @@ class Phong:
         )
 
 
+class GradientOpacity:
+    """Opacity by gradient magnitude: a factor ``g(|grad F|)`` in [0, 1] on the opacity density.
+
+    With it a transfer function classifies by value and gradient magnitude (Levoy 1988,
+    "Display of surfaces from volume data"; VolPack's examples multiply a density ramp by a
+    gradient ramp): ``Omega = O(F) g(|grad F|)``, so that flat regions fade and boundaries
+    show. The factor is piecewise linear through the given points and constant beyond the
+    ends. It multiplies the *density* (per world unit), not a per-sample opacity, so the image
+    converges as the step shrinks; where ``g`` is 0 or 1 the two readings agree.
+
+    Parameters
+    ----------
+    magnitudes : array_like, shape (n,)
+        Increasing gradient magnitudes (field value per world unit), ``n >= 2``, finite, >= 0.
+    factors : array_like, shape (n,)
+        The factor at each magnitude, in [0, 1] (at most 1, so that empty-space skipping's
+        bounds on the density stay bounds).
+
+    Examples
+    --------
+    >>> ramp = GradientOpacity([5.0, 20.0], [0.0, 1.0])
+    >>> ramp.factor(np.array([0.0, 12.5, 100.0])).tolist()
+    [0.0, 0.5, 1.0]
+    """
+
+    def __init__(self, magnitudes, factors):
+        x = validate.finite_array("magnitudes", magnitudes, ndim=1)
+        y = validate.finite_array("factors", factors, ndim=1)
+        if x.shape[0] < 2 or y.shape != x.shape:
+            raise ValueError(f"magnitudes and factors need the same length >= 2, got "
+                             f"{x.shape[0]} and {y.shape[0]}")
+        if np.any(x < 0.0) or np.any(np.diff(x) <= 0.0):
+            raise ValueError(f"magnitudes must be >= 0 and increasing, got {x.tolist()}")
+        if np.any((y < 0.0) | (y > 1.0)):
+            raise ValueError(f"factors must lie in [0, 1], got {y.tolist()}")
+        self.magnitudes = np.ascontiguousarray(x)
+        self.factors = np.ascontiguousarray(y)
+
+    def factor(self, magnitude):
+        """The factor at gradient magnitudes ``magnitude`` (any shape)."""
+        return np.interp(np.asarray(magnitude, dtype=np.float64), self.magnitudes, self.factors)
+
+    def __repr__(self):
+        return (f"GradientOpacity(magnitudes={self.magnitudes.tolist()}, "
+                f"factors={self.factors.tolist()})")
+
+
 class TransferFunction:
-    """Base of the transfer functions: opacity density, emission, optional shading."""
+    """Base of the transfer functions: opacity density, emission, optional shading and
+    gradient opacity."""
 
     shading = None
+    gradient_opacity = None
+
+    @property
+    def needs_gradient(self):
+        """Whether classifying a sample needs the field's gradient (shading or gradient
+        opacity)."""
+        return self.shading is not None or self.gradient_opacity is not None
 
     def opacity_density(self, values):
         """Opacity density ``Omega`` per world unit (>= 0) at reconstructed ``values``."""
@@ -163,6 +220,19 @@ def _check_shading(shading):
     return shading
 
 
+def _check_gradient_opacity(ramp):
+    if ramp is not None and not isinstance(ramp, GradientOpacity):
+        raise TypeError(f"gradient_opacity must be a vrlib.GradientOpacity or None, got {ramp!r}")
+    return ramp
+
+
+def _extras_repr(transfer):
+    out = "" if transfer.shading is None else f", shading={transfer.shading!r}"
+    if transfer.gradient_opacity is not None:
+        out += f", gradient_opacity={transfer.gradient_opacity!r}"
+    return out
+
+
 class Glow(TransferFunction):
     """The thesis's study transfer function: opacity density ``scale * F``, emission 1 (eq 1.9).
 
@@ -178,6 +248,8 @@ class Glow(TransferFunction):
         Opacity density per unit of field value per world unit (> 0).
     shading : Phong, optional
         Gradient shading of the (white) emission.
+    gradient_opacity : GradientOpacity, optional
+        A factor on the density by gradient magnitude.
 
     Examples
     --------
@@ -188,9 +260,10 @@ class Glow(TransferFunction):
     [[1.0, 1.0, 1.0]]
     """
 
-    def __init__(self, scale=1.0, *, shading=None):
+    def __init__(self, scale=1.0, *, shading=None, gradient_opacity=None):
         self.scale = validate.positive_number("scale", scale)
         self.shading = _check_shading(shading)
+        self.gradient_opacity = _check_gradient_opacity(gradient_opacity)
 
     def opacity_density(self, values):
         return self.scale * np.maximum(np.asarray(values, dtype=np.float64), 0.0)
@@ -209,8 +282,7 @@ class Glow(TransferFunction):
 
 
     def __repr__(self):
-        shading = "" if self.shading is None else f", shading={self.shading!r}"
-        return f"Glow({self.scale:g}{shading})"
+        return f"Glow({self.scale:g}{_extras_repr(self)})"
 
 
 class LookupTransfer(TransferFunction):
@@ -227,6 +299,7 @@ class LookupTransfer(TransferFunction):
     value_range : pair of float, default (0, 1)
         The values of the first and last entries (first < last).
     shading : Phong, optional
+    gradient_opacity : GradientOpacity, optional
 
     Examples
     --------
@@ -237,7 +310,8 @@ class LookupTransfer(TransferFunction):
     2.0
     """
 
-    def __init__(self, density, color=None, *, value_range=(0.0, 1.0), shading=None):
+    def __init__(self, density, color=None, *, value_range=(0.0, 1.0), shading=None,
+                 gradient_opacity=None):
         dens = validate.finite_array("density", density, ndim=1)
         if dens.shape[0] < 2:
             raise ValueError(f"density table needs at least 2 entries, got {dens.shape[0]}")
@@ -262,10 +336,11 @@ class LookupTransfer(TransferFunction):
         self.color = np.ascontiguousarray(col)
         self.value_range = (lo, hi)
         self.shading = _check_shading(shading)
+        self.gradient_opacity = _check_gradient_opacity(gradient_opacity)
 
     @classmethod
     def from_alpha(cls, alpha, color=None, *, unit_distance=1.0, value_range=(0.0, 1.0),
-                   shading=None):
+                   shading=None, gradient_opacity=None):
         """Build from opacities per ``unit_distance`` (as VTK's scalar opacity defines them).
 
         ``alpha`` in [0, 1) becomes density ``-ln(1 - alpha) / unit_distance``.
@@ -280,7 +355,8 @@ class LookupTransfer(TransferFunction):
         if np.any((a < 0.0) | (a >= 1.0)):
             raise ValueError("alpha entries must lie in [0, 1) (1 would be infinite density)")
         unit = validate.positive_number("unit_distance", unit_distance)
-        return cls(-np.log1p(-a) / unit, color, value_range=value_range, shading=shading)
+        return cls(-np.log1p(-a) / unit, color, value_range=value_range, shading=shading,
+                   gradient_opacity=gradient_opacity)
 
     def _interp(self, table, values):
         values = np.asarray(values, dtype=np.float64)
@@ -326,4 +402,5 @@ class LookupTransfer(TransferFunction):
 
 
     def __repr__(self):
-        return f"LookupTransfer(<{self.density.shape[0]} entries>, value_range={self.value_range})"
+        return (f"LookupTransfer(<{self.density.shape[0]} entries>, "
+                f"value_range={self.value_range}{_extras_repr(self)})")

@@ -21,7 +21,7 @@ from vrlib._kernels._jit import jit, parallel_jit
 from vrlib._kernels.camera import pixel_ray, ray_box
 from vrlib._kernels.filters import CUBIC, MAX_TAPS, TENT
 from vrlib._kernels.sampling import gradient, reconstruct, separable4, tricubic, trilinear
-from vrlib._kernels.tables import lookup
+from vrlib._kernels.tables import interpolate_channel, lookup, piecewise_linear
 
 
 @jit
@@ -59,7 +59,7 @@ def _exit(ax, ay, az, bx, by, bz, cells, counts, ux, uy, uz):
 def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, camera, height, width, ds,
             fkind, fp0, fp1, fp2, radius, ntaps,
             tstart, tinv, alpha_tab, color_tab, emit_tab,
-            shade, ka, kd, ks, shininess, light, headlight,
+            shade, ka, kd, ks, shininess, light, headlight, ramp_x, ramp_y, by_gradient,
             threshold, empty, coarse, block, mask, tile_h, tile_w, order, out, samples, grey):
     """Render ``out[row, col] = (r, g, b, a)`` premultiplied; count samples per tile.
 
@@ -77,6 +77,8 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, camera, heigh
     (``block = 0`` turns skipping off), and ``mask`` the pixels whose rays can meet a
     non-empty block; ``threshold = 1`` turns early ray termination off.
     ``grey`` says the emission is 1 everywhere and unshaded, so colour equals opacity.
+    ``by_gradient`` multiplies the density by the piecewise-linear factor through
+    ``(ramp_x, ramp_y)`` of the gradient magnitude (per world unit).
     """
     tiles_across = (width + tile_w - 1) // tile_w
     flat = data.reshape(-1)
@@ -88,7 +90,7 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, camera, heigh
     coarse_counts = np.array(coarse.shape)
     ntab = alpha_tab.shape[0]
     inv = 1.0 / spacing
-    plain = fkind == TENT and grey and not shade and block == 0
+    plain = fkind == TENT and grey and not shade and not by_gradient and block == 0
     for it in prange(order.shape[0]):
         tile_id = order[it]
         row0 = (tile_id // tiles_across) * tile_h
@@ -200,44 +202,61 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, camera, heigh
                     alpha = alpha_tab[i] + w * (alpha_tab[i + 1] - alpha_tab[i])
                     if not alpha > 0.0:
                         continue  # a transparent segment adds exactly nothing
-                    if grey:
+                    if grey and not by_gradient:
                         cr = cg = cb = alpha  # white emission, no shading: colour = opacity
-                    elif shade:
-                        gx_, gy_, gz_ = gradient(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1,
-                                                 fp2, radius, ntaps, wx, wy, wz, dx, dy, dz)
-                        gx_ *= inv[0]
-                        gy_ *= inv[1]
-                        gz_ *= inv[2]
-                        norm = math.sqrt(gx_ * gx_ + gy_ * gy_ + gz_ * gz_)
-                        if headlight:
-                            lx, ly, lz = -d[0], -d[1], -d[2]
-                        else:
-                            lx, ly, lz = light[0], light[1], light[2]
-                        # Half-vector of the light and the direction to the eye (-d).
-                        hx, hy, hz = lx - d[0], ly - d[1], lz - d[2]
-                        hn = math.sqrt(hx * hx + hy * hy + hz * hz)
-                        if hn > 0.0:
-                            hx, hy, hz = hx / hn, hy / hn, hz / hn
-                        else:
-                            hx, hy, hz = lx, ly, lz
-                        if norm > 0.0:
-                            ndotl = abs(gx_ * lx + gy_ * ly + gz_ * lz) / norm
-                            ndoth = abs(gx_ * hx + gy_ * hy + gz_ * hz) / norm
-                        else:
-                            ndotl = 1.0
-                            ndoth = 1.0
-                        factor = ka + kd * ndotl
-                        spec = ks * ndoth**shininess
-                        er = emit_tab[i, 0] + w * (emit_tab[i + 1, 0] - emit_tab[i, 0])
-                        eg = emit_tab[i, 1] + w * (emit_tab[i + 1, 1] - emit_tab[i, 1])
-                        eb = emit_tab[i, 2] + w * (emit_tab[i + 1, 2] - emit_tab[i, 2])
-                        cr = (er * factor + spec) * alpha
-                        cg = (eg * factor + spec) * alpha
-                        cb = (eb * factor + spec) * alpha
                     else:
-                        cr = color_tab[i, 0] + w * (color_tab[i + 1, 0] - color_tab[i, 0])
-                        cg = color_tab[i, 1] + w * (color_tab[i + 1, 1] - color_tab[i, 1])
-                        cb = color_tab[i, 2] + w * (color_tab[i + 1, 2] - color_tab[i, 2])
+                        gx_ = gy_ = gz_ = norm = 0.0
+                        if shade or by_gradient:
+                            gx_, gy_, gz_ = gradient(data, offset, gshape, ux, uy, uz, fkind,
+                                                     fp0, fp1, fp2, radius, ntaps, wx, wy, wz,
+                                                     dx, dy, dz)
+                            gx_ *= inv[0]
+                            gy_ *= inv[1]
+                            gz_ *= inv[2]
+                            norm = math.sqrt(gx_ * gx_ + gy_ * gy_ + gz_ * gz_)
+                        if by_gradient:
+                            # Density times g(|grad F|): alpha = 1 - (1 - alpha)^g (eq 1.4).
+                            g = piecewise_linear(ramp_x, ramp_y, norm)
+                            if not g > 0.0:
+                                continue
+                            if g < 1.0 and alpha < 1.0:
+                                alpha = -math.expm1(g * math.log1p(-alpha))
+                        if grey:
+                            cr = cg = cb = alpha
+                        elif shade:
+                            if headlight:
+                                lx, ly, lz = -d[0], -d[1], -d[2]
+                            else:
+                                lx, ly, lz = light[0], light[1], light[2]
+                            # Half-vector of the light and the direction to the eye (-d).
+                            hx, hy, hz = lx - d[0], ly - d[1], lz - d[2]
+                            hn = math.sqrt(hx * hx + hy * hy + hz * hz)
+                            if hn > 0.0:
+                                hx, hy, hz = hx / hn, hy / hn, hz / hn
+                            else:
+                                hx, hy, hz = lx, ly, lz
+                            if norm > 0.0:
+                                ndotl = abs(gx_ * lx + gy_ * ly + gz_ * lz) / norm
+                                ndoth = abs(gx_ * hx + gy_ * hy + gz_ * hz) / norm
+                            else:
+                                ndotl = 1.0
+                                ndoth = 1.0
+                            factor = ka + kd * ndotl
+                            spec = ks * ndoth**shininess
+                            er = emit_tab[i, 0] + w * (emit_tab[i + 1, 0] - emit_tab[i, 0])
+                            eg = emit_tab[i, 1] + w * (emit_tab[i + 1, 1] - emit_tab[i, 1])
+                            eb = emit_tab[i, 2] + w * (emit_tab[i + 1, 2] - emit_tab[i, 2])
+                            cr = (er * factor + spec) * alpha
+                            cg = (eg * factor + spec) * alpha
+                            cb = (eb * factor + spec) * alpha
+                        elif by_gradient:
+                            cr = interpolate_channel(emit_tab, tstart, tinv, value, 0) * alpha
+                            cg = interpolate_channel(emit_tab, tstart, tinv, value, 1) * alpha
+                            cb = interpolate_channel(emit_tab, tstart, tinv, value, 2) * alpha
+                        else:
+                            cr = color_tab[i, 0] + w * (color_tab[i + 1, 0] - color_tab[i, 0])
+                            cg = color_tab[i, 1] + w * (color_tab[i + 1, 1] - color_tab[i, 1])
+                            cb = color_tab[i, 2] + w * (color_tab[i + 1, 2] - color_tab[i, 2])
                     # Front-to-back over, eqs 1.7-1.8.
                     remaining = 1.0 - acc_a
                     acc_r += remaining * cr

@@ -33,3 +33,16 @@ def interpolate_channel(tab, start, inv, value, channel):
     """Column ``channel`` of the 2-D table ``tab`` at ``value``, as :func:`interpolate`."""
     i, w = lookup((value - start) * inv, tab.shape[0])
     return tab[i, channel] + w * (tab[i + 1, channel] - tab[i, channel])
+
+
+@jit
+def piecewise_linear(xs, ys, x):
+    """The piecewise-linear function through points ``(xs, ys)`` (``xs`` increasing) at ``x``,
+    constant beyond the ends (as ``numpy.interp``); a short table, searched in order."""
+    n = xs.shape[0]
+    if not x > xs[0]:  # also catches NaN
+        return ys[0]
+    for i in range(1, n):
+        if x <= xs[i]:
+            return ys[i - 1] + (x - xs[i - 1]) / (xs[i] - xs[i - 1]) * (ys[i] - ys[i - 1])
+    return ys[n - 1]

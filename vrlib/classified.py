@@ -1,0 +1,236 @@
+"""A volume classified once and rendered from many views: shear-warp VolPack's way.
+
+:func:`classify` evaluates the transfer function at every voxel once (value, gradient
+magnitude, shading normal), as VolPack's ``vpClassifyVolume`` does, and
+:meth:`ClassifiedVolume.render` renders any orthographic view from it with the classified
+shear-warp kernel (:mod:`vrlib._kernels.classified`): only visible voxels are stored and
+visited, opaque intermediate pixels are skipped, and shading is a table lookup per voxel built
+once per frame.
+
+It differs from ``render(volume, view, method="shearwarp")`` (post-classification: values are
+resampled with any filter, then classified) in what it interpolates: each sample mixes its
+four voxels' extinctions and colours bilinearly (pre-classification, Lacroute and Levoy 1994),
+so it is faster and less accurate where the transfer function is steep. Deviation from VolPack:
+VolPack stores a voxel opacity and composites it uncorrected for the slice spacing along the
+ray; here a voxel stores its extinction per world unit and a segment's opacity is
+``1 - exp(-sigma L)`` for the view's slice spacing ``L``, so images do not darken off-axis.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from vrlib import validate
+from vrlib._kernels.classified import composite_classified
+from vrlib._kernels.shear import warp
+from vrlib._scheduling import thread_count
+from vrlib.arguments import check_transfer, check_view
+from vrlib.image import Image, RenderStats
+from vrlib.shearwarp import intermediate_plane, warp_homography
+from vrlib.view import principal_axis
+from vrlib.volume import Volume
+
+__all__ = ["classify", "ClassifiedVolume", "NORMAL_BINS", "encode_normals", "decode_normals"]
+
+#: Octahedral normal codes per side: ``NORMAL_BINS**2`` directions (about 0.9 degree apart at
+#: worst, VolPack's 13-bit code has 7924) and one more code for "no gradient".
+NORMAL_BINS = 96
+
+#: Axis order of ``Volume.slices(axis)`` on a ``[z, y, x]`` array: ``[slice, row, column]``.
+_SLICE_ORDER = {0: (2, 0, 1), 1: (1, 0, 2), 2: (0, 1, 2)}
+
+
+def encode_normals(gradient):
+    """Octahedral codes of gradient directions ``(..., 3)``; zero gradients get
+    ``NORMAL_BINS**2`` (no normal).
+
+    Examples
+    --------
+    >>> codes = encode_normals(np.array([[0.0, 0.0, 2.0], [0.0, 0.0, 0.0]]))
+    >>> np.allclose(decode_normals()[codes[0]], [0, 0, 1], atol=0.02), int(codes[1])
+    (True, 9216)
+    """
+    g = np.asarray(gradient, dtype=np.float64)
+    l1 = np.abs(g).sum(axis=-1)
+    safe = np.where(l1 > 0.0, l1, 1.0)
+    x, y, z = (g[..., a] / safe for a in range(3))
+    below = z < 0.0
+    fx = np.where(below, (1.0 - np.abs(y)) * np.where(x >= 0.0, 1.0, -1.0), x)
+    fy = np.where(below, (1.0 - np.abs(x)) * np.where(y >= 0.0, 1.0, -1.0), y)
+    u = np.clip(((fx + 1.0) * 0.5 * NORMAL_BINS).astype(np.int64), 0, NORMAL_BINS - 1)
+    v = np.clip(((fy + 1.0) * 0.5 * NORMAL_BINS).astype(np.int64), 0, NORMAL_BINS - 1)
+    return np.where(l1 > 0.0, v * NORMAL_BINS + u, NORMAL_BINS**2).astype(np.uint16)
+
+
+def decode_normals():
+    """The unit direction of every normal code (the centre of its octahedral bin), and a zero
+    vector for the last code (no gradient): ``(NORMAL_BINS**2 + 1, 3)``."""
+    centre = (np.arange(NORMAL_BINS) + 0.5) / NORMAL_BINS * 2.0 - 1.0
+    fy, fx = np.meshgrid(centre, centre, indexing="ij")
+    z = 1.0 - np.abs(fx) - np.abs(fy)
+    below = z < 0.0
+    x = np.where(below, (1.0 - np.abs(fy)) * np.sign(fx), fx)
+    y = np.where(below, (1.0 - np.abs(fx)) * np.sign(fy), fy)
+    n = np.stack([x, y, z], axis=-1).reshape(-1, 3)
+    n /= np.linalg.norm(n, axis=-1, keepdims=True)
+    return np.concatenate([n, np.zeros((1, 3))])
+
+
+def classify(volume, transfer=None, *, min_opacity=0.0):
+    """Classify ``volume`` under ``transfer`` once, for fast shear-warp rendering of any view.
+
+    Parameters
+    ----------
+    volume : Volume
+    transfer : TransferFunction, default ``Glow(1.0)``
+        Any transfer function, shaded or not, with or without gradient opacity
+        (:class:`vrlib.GradientOpacity`).
+    min_opacity : float, default 0
+        Voxels whose opacity over one voxel spacing along the slice axis is at most this are
+        not stored (VolPack's ``VP_MIN_VOXEL_OPACITY``): 0 drops only voxels that add nothing
+        (exact), larger values drop faint voxels too (lossy).
+
+    Returns
+    -------
+    ClassifiedVolume
+
+    Examples
+    --------
+    >>> import data_gen, vrlib
+    >>> vol = data_gen.make_field("gaussian-blob", sigma=0.3).sample(24)
+    >>> scene = vrlib.classify(vol, vrlib.Glow(2.0, shading=vrlib.Phong()))
+    >>> img = scene.render(vrlib.View.orbit(azimuth=30, size=16))
+    >>> img.shape, bool(0.1 < img.alpha.max() < 1.0)
+    ((16, 16), True)
+    """
+    return ClassifiedVolume(volume, transfer, min_opacity=min_opacity)
+
+
+class ClassifiedVolume:
+    """A volume with its transfer function applied at every voxel (see :func:`classify`).
+
+    Per voxel it holds the extinction ``sigma = O(F) g(|grad F|)`` (per world unit), an
+    emission code (the value's entry in the transfer function's table) and a normal code
+    (:func:`encode_normals` of the central-difference gradient); per principal axis, built on
+    first use, the run-length encoding of the visible voxels' scanlines.
+    """
+
+    def __init__(self, volume, transfer=None, *, min_opacity=0.0):
+        if not isinstance(volume, Volume):
+            raise TypeError(f"volume must be a vrlib.Volume, got {type(volume).__name__}")
+        self.volume = volume
+        self.transfer = check_transfer(transfer)
+        self.min_opacity = validate.finite_number("min_opacity", min_opacity, low=0.0,
+                                                  high=1.0, high_open=True)
+        start = time.perf_counter()
+        data = volume.data
+        lo, hi = float(data.min()), float(data.max())
+        sigma = self.transfer.opacity_density(data)
+        normal = np.full(volume.shape, NORMAL_BINS**2, dtype=np.uint16)
+        if self.transfer.needs_gradient:
+            # Central differences (one-sided at the faces), per world unit: gz, gy, gx.
+            h = volume.spacing
+            grad = np.stack(np.gradient(data.astype(np.float64), h[2], h[1], h[0])[::-1], -1)
+            if self.transfer.gradient_opacity is not None:
+                sigma = sigma * self.transfer.gradient_opacity.factor(
+                    np.linalg.norm(grad, axis=-1))
+            if self.transfer.shading is not None:
+                normal = encode_normals(grad)
+            del grad
+        self._sigma = np.asarray(sigma, dtype=np.float32)
+        self._normal = normal
+        vstart, inv, _, emit = self.transfer.value_table(lo, hi)
+        self._emission = np.ascontiguousarray(emit, dtype=np.float64)
+        self._emission_code = np.clip(np.rint((data - vstart) * inv), 0,
+                                      emit.shape[0] - 1).astype(np.uint16)
+        self._grey = bool(np.all(emit == 1.0))
+        self._encodings = {}
+        self.seconds = time.perf_counter() - start
+
+    def __repr__(self):
+        return (f"ClassifiedVolume({self.volume!r}, {self.transfer!r}, "
+                f"min_opacity={self.min_opacity:g})")
+
+    def encoding(self, axis):
+        """Run-length encoding along ``axis`` (0, 1, 2 for x, y, z), built on first use:
+        ``(run_ptr, run_start, run_end, run_voxel, sigma, emission_code, normal_code)``
+        (see :func:`vrlib._kernels.classified.composite_classified`)."""
+        if axis not in self._encodings:
+            start = time.perf_counter()
+            perm = _SLICE_ORDER[axis]
+            sigma = self._sigma.transpose(perm)
+            # Stored: opacity over one spacing along the axis above min_opacity.
+            cutoff = -math.log1p(-self.min_opacity) / self.volume.spacing[axis]
+            visible = sigma > cutoff
+            n_k, n_j, n_i = visible.shape
+            edges = np.diff(np.pad(visible.reshape(n_k * n_j, n_i), ((0, 0), (1, 1))).view(
+                np.int8), axis=1)
+            line, run_start = np.nonzero(edges == 1)
+            run_end = np.nonzero(edges == -1)[1]
+            run_ptr = np.zeros(n_k * n_j + 1, dtype=np.int64)
+            np.cumsum(np.bincount(line, minlength=n_k * n_j), out=run_ptr[1:])
+            lengths = run_end - run_start
+            run_voxel = np.zeros(lengths.size, dtype=np.int64)
+            np.cumsum(lengths[:-1], out=run_voxel[1:])
+            self._encodings[axis] = (
+                run_ptr, run_start.astype(np.int64), run_end.astype(np.int64), run_voxel,
+                np.ascontiguousarray(sigma[visible]),
+                np.ascontiguousarray(self._emission_code.transpose(perm)[visible]),
+                np.ascontiguousarray(self._normal.transpose(perm)[visible]))
+            self.seconds += time.perf_counter() - start
+        return self._encodings[axis]
+
+    @property
+    def stored_voxels(self):
+        """Voxels stored along each axis encoded so far, ``{axis: count}``."""
+        return {axis: int(enc[4].size) for axis, enc in self._encodings.items()}
+
+    def _shade_tables(self, view):
+        """Per normal code, the multiplier of the emission and the highlight added to it."""
+        shading = self.transfer.shading
+        if shading is None:
+            return np.ones(NORMAL_BINS**2 + 1), np.zeros(NORMAL_BINS**2 + 1)
+        normals = decode_normals()
+        return shading.factor(normals, -view.forward), shading.highlight(normals, -view.forward)
+
+    def render(self, view, *, early_termination=0.999, threads=None):
+        """Render an orthographic ``view`` (arguments as :func:`vrlib.render`).
+
+        Returns
+        -------
+        Image
+            Premultiplied RGBA; ``stats.samples`` counts the composited samples.
+        """
+        check_view(view)
+        if view.is_perspective:
+            raise ValueError("a ClassifiedVolume renders orthographic views only (as VolPack); "
+                             "use vrlib.render(volume, view, method='shearwarp') for perspective")
+        threshold = validate.finite_number("early_termination", early_termination, low=0.0,
+                                           high=1.0, low_open=True)
+        volume = self.volume
+        axis, ascending = principal_axis(view, volume)
+        encoded = self.encoding(axis)
+        with thread_count(threads):
+            start = time.perf_counter()
+            _, di, dj, (oi, oj), (height, width), kf, _ = intermediate_plane(
+                volume, view, axis, ascending)
+            n_k, n_j = volume.slices(axis).shape[:2]
+            order = np.arange(n_k) if ascending else np.arange(n_k)[::-1].copy()
+            length = float(volume.spacing[axis] / abs(view.forward[axis]))
+            factor, highlight = self._shade_tables(view)
+            inter = np.zeros((height, width, 4))
+            counts = np.zeros(height, np.int64)
+            composite_classified(*encoded, n_j, order, di, dj, length, self._emission, factor,
+                                 highlight, self._grey, threshold, inter, counts)
+            plane = volume.origin[axis] + kf * volume.spacing[axis]
+            out = np.empty(view.shape + (4,))
+            warp(inter, warp_homography(view, volume, axis, plane, (oi, oj)), out)
+            taken = int(counts.sum())
+            stats = RenderStats(samples=taken, operations=taken * 40 + out.size * 8,
+                                bytes=int(sum(a.nbytes for a in encoded) + inter.nbytes
+                                          + out.nbytes),
+                                seconds=time.perf_counter() - start, voxels=taken)
+        return Image(np.clip(out, 0.0, 1.0), stats)
