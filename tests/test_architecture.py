@@ -20,7 +20,8 @@ PACKAGE = ROOT / "vrlib"
 RENDERERS = sorted({fn.__module__ for fn in vrlib.METHODS.values()} | {"vrlib.reference"})
 #: Kernel modules every kernel may use; the renderers' own kernels are not among them.
 SHARED_KERNELS = {"vrlib._kernels._jit", "vrlib._kernels.filters", "vrlib._kernels.sampling",
-                  "vrlib._kernels.camera", "vrlib._kernels.tables"}
+                  "vrlib._kernels.camera", "vrlib._kernels.tables",
+                  "vrlib._kernels.shading"}
 
 
 def module_name(path):

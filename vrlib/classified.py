@@ -18,17 +18,20 @@ ray; here a voxel stores its extinction per world unit and a segment's opacity i
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 
+import numba
 import numpy as np
 
 from vrlib import validate
-from vrlib._kernels.classified import composite_classified
+from vrlib._kernels.classified import composite_classified, shade_table
 from vrlib._kernels.shear import warp
-from vrlib._scheduling import thread_count
+from vrlib._scheduling import balanced_order, thread_count
 from vrlib.arguments import check_transfer, check_view
 from vrlib.image import Image, RenderStats
+from vrlib.transfer import Phong
 from vrlib.shearwarp import intermediate_plane, warp_homography
 from vrlib.view import principal_axis
 from vrlib.volume import Volume
@@ -38,6 +41,9 @@ __all__ = ["classify", "ClassifiedVolume", "NORMAL_BINS", "encode_normals", "dec
 #: Octahedral normal codes per side: ``NORMAL_BINS**2`` directions (about 0.9 degree apart at
 #: worst, VolPack's 13-bit code has 7924) and one more code for "no gradient".
 NORMAL_BINS = 96
+
+#: Intermediate-image rows per unit of parallel work.
+BAND = 8
 
 #: Axis order of ``Volume.slices(axis)`` on a ``[z, y, x]`` array: ``[slice, row, column]``.
 _SLICE_ORDER = {0: (2, 0, 1), 1: (1, 0, 2), 2: (0, 1, 2)}
@@ -77,6 +83,11 @@ def decode_normals():
     n = np.stack([x, y, z], axis=-1).reshape(-1, 3)
     n /= np.linalg.norm(n, axis=-1, keepdims=True)
     return np.concatenate([n, np.zeros((1, 3))])
+
+
+@functools.cache
+def _normals():
+    return decode_normals()
 
 
 def classify(volume, transfer=None, *, min_opacity=0.0):
@@ -148,6 +159,7 @@ class ClassifiedVolume:
                                       emit.shape[0] - 1).astype(np.uint16)
         self._grey = bool(np.all(emit == 1.0))
         self._encodings = {}
+        self._line_runs = {}
         self.seconds = time.perf_counter() - start
 
     def __repr__(self):
@@ -172,32 +184,63 @@ class ClassifiedVolume:
             run_end = np.nonzero(edges == -1)[1]
             run_ptr = np.zeros(n_k * n_j + 1, dtype=np.int64)
             np.cumsum(np.bincount(line, minlength=n_k * n_j), out=run_ptr[1:])
+            # Each run's voxels stored between two transparent guards: run_voxel + 1 on.
             lengths = run_end - run_start
             run_voxel = np.zeros(lengths.size, dtype=np.int64)
-            np.cumsum(lengths[:-1], out=run_voxel[1:])
-            self._encodings[axis] = (
-                run_ptr, run_start.astype(np.int64), run_end.astype(np.int64), run_voxel,
-                np.ascontiguousarray(sigma[visible]),
-                np.ascontiguousarray(self._emission_code.transpose(perm)[visible]),
-                np.ascontiguousarray(self._normal.transpose(perm)[visible]))
+            np.cumsum(lengths[:-1] + 2, out=run_voxel[1:])
+            slots = np.ones(int(lengths.sum()) + 2 * lengths.size, dtype=bool)
+            slots[run_voxel] = False
+            slots[run_voxel + lengths + 1] = False
+            guarded = [np.zeros(slots.size, dtype=a.dtype) for a in
+                       (self._sigma, self._emission_code, self._normal)]
+            for out, dense in zip(guarded, (self._sigma, self._emission_code, self._normal),
+                                  strict=True):
+                out[slots] = dense.transpose(perm)[visible]
+            self._encodings[axis] = (run_ptr, run_start.astype(np.int64),
+                                     run_end.astype(np.int64), run_voxel, *guarded)
             self.seconds += time.perf_counter() - start
         return self._encodings[axis]
 
     @property
     def stored_voxels(self):
         """Voxels stored along each axis encoded so far, ``{axis: count}``."""
-        return {axis: int(enc[4].size) for axis, enc in self._encodings.items()}
+        return {axis: int(enc[4].size - 2 * enc[1].size) for axis, enc in
+                self._encodings.items()}
 
-    def _shade_tables(self, view):
+    def _shade_tables(self, view, shading):
         """Per normal code, the multiplier of the emission and the highlight added to it."""
-        shading = self.transfer.shading
+        count = NORMAL_BINS**2 + 1
         if shading is None:
-            return np.ones(NORMAL_BINS**2 + 1), np.zeros(NORMAL_BINS**2 + 1)
-        normals = decode_normals()
-        return shading.factor(normals, -view.forward), shading.highlight(normals, -view.forward)
+            return np.ones(count), np.zeros(count)
+        light = -view.forward if shading.light is None else shading.light
+        factor, highlight = np.empty(count), np.empty(count)
+        shade_table(_normals(), np.asarray(light, np.float64), view.forward, shading.ambient,
+                    shading.diffuse, shading.specular, shading.shininess, factor, highlight)
+        return factor, highlight
 
-    def render(self, view, *, early_termination=0.999, threads=None):
-        """Render an orthographic ``view`` (arguments as :func:`vrlib.render`).
+    def _band_order(self, axis, dj, height):
+        """Bands of :data:`BAND` intermediate rows in an order that shares them evenly among
+        threads, by the runs their scanlines hold (the middle slice's shift maps rows to
+        scanlines)."""
+        if axis not in self._line_runs:
+            run_ptr = self.encoding(axis)[0]
+            n_k, n_j = self.volume.slices(axis).shape[:2]
+            self._line_runs[axis] = np.diff(run_ptr).reshape(n_k, n_j).sum(axis=0) + 1.0
+        runs = self._line_runs[axis]
+        lines = np.clip(np.arange(height) + int(round(dj[dj.size // 2])), 0, runs.size - 1)
+        cost = np.zeros(-(-height // BAND) * BAND)
+        cost[:height] = runs[lines]
+        return balanced_order(cost.reshape(-1, BAND).sum(axis=1), numba.get_num_threads())
+
+    def render(self, view, *, early_termination=0.999, shading=None, threads=None):
+        """Render an orthographic ``view`` (other arguments as :func:`vrlib.render`).
+
+        Parameters
+        ----------
+        shading : Phong, optional
+            This frame's lighting, in place of the transfer function's (a light that moves
+            with the eye, as VolPack's lights do); only for a volume classified with shading,
+            whose normals are stored.
 
         Returns
         -------
@@ -210,6 +253,13 @@ class ClassifiedVolume:
                              "use vrlib.render(volume, view, method='shearwarp') for perspective")
         threshold = validate.finite_number("early_termination", early_termination, low=0.0,
                                            high=1.0, low_open=True)
+        if shading is None:
+            shading = self.transfer.shading
+        elif self.transfer.shading is None:
+            raise ValueError("shading needs the normals of a volume classified with shading: "
+                             "classify with a shaded transfer function")
+        elif not isinstance(shading, Phong):
+            raise TypeError(f"shading must be a vrlib.Phong or None, got {shading!r}")
         volume = self.volume
         axis, ascending = principal_axis(view, volume)
         encoded = self.encoding(axis)
@@ -220,11 +270,13 @@ class ClassifiedVolume:
             n_k, n_j = volume.slices(axis).shape[:2]
             order = np.arange(n_k) if ascending else np.arange(n_k)[::-1].copy()
             length = float(volume.spacing[axis] / abs(view.forward[axis]))
-            factor, highlight = self._shade_tables(view)
+            factor, highlight = self._shade_tables(view, shading)
             inter = np.zeros((height, width, 4))
             counts = np.zeros(height, np.int64)
             composite_classified(*encoded, n_j, order, di, dj, length, self._emission, factor,
-                                 highlight, self._grey, threshold, inter, counts)
+                                 highlight, self._grey, threshold, BAND,
+                                 self._band_order(axis, dj, height), inter,
+                                 counts)
             plane = volume.origin[axis] + kf * volume.spacing[axis]
             out = np.empty(view.shape + (4,))
             warp(inter, warp_homography(view, volume, axis, plane, (oi, oj)), out)
@@ -233,4 +285,4 @@ class ClassifiedVolume:
                                 bytes=int(sum(a.nbytes for a in encoded) + inter.nbytes
                                           + out.nbytes),
                                 seconds=time.perf_counter() - start, voxels=taken)
-        return Image(np.clip(out, 0.0, 1.0), stats)
+        return Image(out, stats)

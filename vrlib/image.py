@@ -86,7 +86,7 @@ class Image:
         if arr.shape[2] != 4:
             raise ValueError(f"rgba must have shape (height, width, 4), got {arr.shape}")
         alpha = arr[..., 3]
-        if np.any((alpha < 0.0) | (alpha > 1.0 + 1e-9)):
+        if alpha.size and not (alpha.min() >= 0.0 and alpha.max() <= 1.0 + 1e-9):
             raise ValueError("rgba alpha must lie in [0, 1]")
         self.rgba = arr
         self.stats = RenderStats() if stats is None else stats

@@ -183,4 +183,4 @@ def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
     stats = RenderStats(samples=resampled, operations=resampled * (2 * ntaps**2 + 12)
                         + out.size * 8, bytes=int(volume.data.nbytes + inter.nbytes + out.nbytes),
                         seconds=time.perf_counter() - start, voxels=resampled)
-    return Image(np.clip(out, 0.0, 1.0), stats)
+    return Image(out, stats)

@@ -72,7 +72,11 @@ def finite_array(name, value, *, ndim=None, dtype=np.float64):
     arr = arr.astype(dtype, copy=False)
     if ndim is not None and arr.ndim != ndim:
         raise ValueError(f"{name} must be {ndim}-dimensional, got shape {arr.shape}")
-    if not np.all(np.isfinite(arr)):
+    # A NaN or infinity anywhere makes the sum non-finite; a finite sum proves all are finite
+    # (one pass, no temporary), and only an overflowing sum needs the element-wise test.
+    with np.errstate(over="ignore", invalid="ignore"):
+        total = arr.sum()
+    if arr.size and not np.isfinite(total) and not np.all(np.isfinite(arr)):
         raise ValueError(f"{name} must hold only finite values (found NaN or infinity)")
     return arr
 

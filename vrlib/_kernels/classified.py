@@ -23,145 +23,171 @@ import numpy as np
 from numba import prange
 
 from vrlib._kernels._jit import jit, parallel_jit
+from vrlib._kernels.shading import phong
 
 
-@jit
-def _open(links, i):
-    """First pixel at or after ``i`` that is not opaque; compresses the path it walked."""
+@parallel_jit
+def shade_table(normals, light, direction, ka, kd, ks, shininess, factor, highlight):
+    """Phong's ``factor`` and ``highlight`` for every normal code (``normals``: one unit vector
+    per code, zero for "no gradient"), lit from ``light`` and seen along ``direction``:
+    shading as a table lookup per voxel, rebuilt once per frame (VolPack's lookup shader)."""
+    for n in prange(normals.shape[0]):
+        factor[n], highlight[n] = phong(normals[n, 0], normals[n, 1], normals[n, 2], light[0],
+                                        light[1], light[2], direction[0], direction[1],
+                                        direction[2], ka, kd, ks, shininess)
+
+
+@jit(inline="always")
+def _open(links, row, i):
+    """First pixel at or after ``i`` of ``row`` that is not opaque; compresses the path."""
     root = i
-    while links[root] != root:
-        root = links[root]
-    while links[i] != root:
-        following = links[i]
-        links[i] = root
+    while links[row, root] != root:
+        root = links[row, root]
+    while links[row, i] != root:
+        following = links[row, i]
+        links[row, i] = root
         i = following
     return root
 
 
-@jit
-def _voxel(run_start, run_end, run_voxel, cursor, last, column):
-    """Advance a scanline's run ``cursor`` (runs ``cursor .. last - 1``, increasing columns) to
-    ``column``: returns the cursor and the stored voxel's index there, or -1 (transparent)."""
-    while cursor < last and run_end[cursor] <= column:
-        cursor += 1
-    if cursor < last and run_start[cursor] <= column:
-        return cursor, run_voxel[cursor] + column - run_start[cursor]
-    return cursor, -1
+@jit(inline="always")
+def _add(v, w_left, w_right, sigma, emission_code, normal_code, emission, factor, highlight,
+         grey, sums):
+    """Add voxels ``v`` (weight ``w_left``) and ``v + 1`` (``w_right``) of one scanline to a
+    sample's ``sums = (extinction, r, g, b)``, each colour weighted by its extinction."""
+    for u, w in ((v, w_left), (v + 1, w_right)):
+        q = w * sigma[u]
+        n = normal_code[u]
+        sums[0] += q
+        if grey:
+            sums[1] += q * (factor[n] + highlight[n])
+        else:
+            e = emission_code[u]
+            sums[1] += q * (emission[e, 0] * factor[n] + highlight[n])
+            sums[2] += q * (emission[e, 1] * factor[n] + highlight[n])
+            sums[3] += q * (emission[e, 2] * factor[n] + highlight[n])
 
 
 @parallel_jit
 def composite_classified(run_ptr, run_start, run_end, run_voxel, sigma, emission_code,
                          normal_code, n_j, order, di, dj, length, emission, factor, highlight,
-                         grey, threshold, inter, counts):
+                         grey, threshold, band_rows, bands, inter, counts):
     """Composite the slices ``order`` (front to back) into ``inter[J, I] = (r, g, b, a)``.
 
     Slice ``k``'s sample for intermediate pixel ``(I, J)`` lies at column ``I + di[k]`` and row
     ``J + dj[k]`` of the slice's ``n_j`` scanlines; scanline ``k * n_j + j`` holds runs
-    ``run_ptr[.] .. run_ptr[. + 1] - 1`` (columns ``[run_start, run_end)``, first stored voxel
-    ``run_voxel``). A voxel's colour is ``emission[e] * factor[n] + highlight[n]`` for its
-    codes ``e`` and ``n`` (``grey``: ``factor[n] + highlight[n]``). Rows are independent and
-    each is composited in a fixed order: the image does not depend on the thread count.
-    ``counts[J]`` gets the samples row ``J`` composited.
+    ``run_ptr[.] .. run_ptr[. + 1] - 1`` of columns ``[run_start, run_end)`` whose voxels are
+    stored from ``run_voxel + 1`` on, between two transparent guard voxels (so that a sample at
+    a run's edge reads a zero neighbour without a test). A voxel's colour is
+    ``emission[e] * factor[n] + highlight[n]`` for its codes ``e`` and ``n`` (``grey``: white).
+
+    The image is cut into bands of ``band_rows`` rows, taken in the order ``bands`` (spread so
+    that threads share the work); a band walks the slices front to back and, in each, its rows
+    in order, so that it reads the encoding sequentially (VolPack's object order). Each row is
+    composited in a fixed order: the image does not depend on the thread count. ``counts[J]``
+    gets the samples row ``J`` composited.
     """
     height, width = inter.shape[0], inter.shape[1]
-    for row in prange(height):
-        links = np.arange(width + 1)
-        opaque = 0
-        taken = 0
+    for it in prange(bands.shape[0]):
+        first_row = bands[it] * band_rows
+        rows = min(band_rows, height - first_row)
+        links = np.empty((rows, width + 1), dtype=np.int64)
+        for r in range(rows):
+            for i in range(width + 1):
+                links[r, i] = i
+        opaque = np.zeros(rows, dtype=np.int64)
+        taken = np.zeros(rows, dtype=np.int64)
+        sums = np.empty(4)
         for step in range(order.shape[0]):
-            if opaque == width:
-                break
             k = order[step]
-            y = row + dj[k]
-            r0 = math.floor(y)
-            fj = y - r0
             s_i = math.floor(di[k])
             fi = di[k] - s_i
-            # The runs of the two scanlines around the row: r0 (weight 1 - fj), r0 + 1 (fj).
-            a0 = b0 = a1 = b1 = 0
-            if 0 <= r0 < n_j:
-                a0 = run_ptr[k * n_j + r0]
-                b0 = run_ptr[k * n_j + r0 + 1]
-            if fj > 0.0 and 0 <= r0 + 1 < n_j:
-                a1 = run_ptr[k * n_j + r0 + 1]
-                b1 = run_ptr[k * n_j + r0 + 2]
-            w00 = (1.0 - fi) * (1.0 - fj)
-            w01 = fi * (1.0 - fj)
-            w10 = (1.0 - fi) * fj
-            w11 = fi * fj
             before = 1 if fi > 0.0 else 0  # a voxel also feeds the pixel to its left
-            c00 = c01 = a0
-            c10 = c11 = a1
-            p0, p1 = a0, a1
-            done = 0
-            while p0 < b0 or p1 < b1:
-                # The next run of either scanline, by first column: the pixels it touches.
-                if p1 >= b1 or (p0 < b0 and run_start[p0] <= run_start[p1]):
-                    first, stop = run_start[p0], run_end[p0]
-                    p0 += 1
-                else:
-                    first, stop = run_start[p1], run_end[p1]
-                    p1 += 1
-                lo = max(first - s_i - before, done, 0)
-                hi = min(stop - s_i, width)
-                if lo >= hi:
+            for r in range(rows):
+                if opaque[r] == width:
                     continue
-                done = hi
-                pixel = _open(links, lo)
-                while pixel < hi:
-                    column = pixel + s_i
-                    ext = 0.0
-                    cr = 0.0
-                    cg = 0.0
-                    cb = 0.0
-                    for corner in range(4):
-                        if corner == 0:
-                            c00, v = _voxel(run_start, run_end, run_voxel, c00, b0, column)
-                            wt = w00
-                        elif corner == 1:
-                            if not fi > 0.0:
-                                continue
-                            c01, v = _voxel(run_start, run_end, run_voxel, c01, b0, column + 1)
-                            wt = w01
-                        elif corner == 2:
-                            if not fj > 0.0:
-                                continue
-                            c10, v = _voxel(run_start, run_end, run_voxel, c10, b1, column)
-                            wt = w10
+                row = first_row + r
+                y = row + dj[k]
+                r0 = math.floor(y)
+                fj = y - r0
+                # Two streams, the scanlines around the row: r0 (weight 1 - fj), r0 + 1 (fj).
+                # A run [start, end) of either touches the pixels [start - s_i - before,
+                # end - s_i); the runs of one scanline touch disjoint pixels.
+                c0 = e0 = c1 = e1 = 0
+                if 0 <= r0 < n_j:
+                    c0 = run_ptr[k * n_j + r0]
+                    e0 = run_ptr[k * n_j + r0 + 1]
+                if fj > 0.0 and 0 <= r0 + 1 < n_j:
+                    c1 = run_ptr[k * n_j + r0 + 1]
+                    e1 = run_ptr[k * n_j + r0 + 2]
+                if c0 == e0 and c1 == e1:
+                    continue
+                w00 = (1.0 - fi) * (1.0 - fj)
+                w01 = fi * (1.0 - fj)
+                w10 = (1.0 - fi) * fj
+                w11 = fi * fj
+                # Walk the segments over which each stream stays inside one run or outside all:
+                # within one, a run's voxel for the pixel is base + pixel (VolPack's run
+                # merging), and the loop over the segment's open pixels keeps no books.
+                pos = 0
+                while True:
+                    pos = _open(links, r, pos)  # past opaque pixels: their voxels are skipped
+                    if pos >= width:
+                        break
+                    following = width
+                    in0 = in1 = False
+                    base0 = base1 = 0
+                    while c0 < e0 and run_end[c0] - s_i <= pos:
+                        c0 += 1
+                    if c0 < e0:
+                        lo = run_start[c0] - s_i - before
+                        if lo <= pos:
+                            in0 = True
+                            base0 = run_voxel[c0] + 1 - run_start[c0] + s_i
+                            following = min(following, run_end[c0] - s_i)
                         else:
-                            if not (fi > 0.0 and fj > 0.0):
-                                continue
-                            c11, v = _voxel(run_start, run_end, run_voxel, c11, b1, column + 1)
-                            wt = w11
-                        if v < 0:
-                            continue
-                        q = wt * sigma[v]
-                        n = normal_code[v]
-                        ext += q
-                        if grey:
-                            lum = factor[n] + highlight[n]
-                            cr += q * lum
+                            following = min(following, lo)
+                    while c1 < e1 and run_end[c1] - s_i <= pos:
+                        c1 += 1
+                    if c1 < e1:
+                        lo = run_start[c1] - s_i - before
+                        if lo <= pos:
+                            in1 = True
+                            base1 = run_voxel[c1] + 1 - run_start[c1] + s_i
+                            following = min(following, run_end[c1] - s_i)
                         else:
-                            e = emission_code[v]
-                            cr += q * (emission[e, 0] * factor[n] + highlight[n])
-                            cg += q * (emission[e, 1] * factor[n] + highlight[n])
-                            cb += q * (emission[e, 2] * factor[n] + highlight[n])
-                    taken += 1
-                    if ext > 0.0:
-                        # Segment opacity (eq 1.4) and colour (eq 1.9), composited front to
-                        # back (eqs 1.7-1.8).
-                        alpha = -math.expm1(-ext * length)
-                        scale = alpha / ext
-                        if grey:
-                            cg = cr
-                            cb = cr
-                        remaining = 1.0 - inter[row, pixel, 3]
-                        inter[row, pixel, 0] += remaining * cr * scale
-                        inter[row, pixel, 1] += remaining * cg * scale
-                        inter[row, pixel, 2] += remaining * cb * scale
-                        inter[row, pixel, 3] += remaining * alpha
-                        if inter[row, pixel, 3] >= threshold:
-                            links[pixel] = pixel + 1
-                            opaque += 1
-                    pixel = _open(links, pixel + 1)
-        counts[row] = taken
+                            following = min(following, lo)
+                    if not (in0 or in1):
+                        pos = following
+                        continue
+                    pixel = pos
+                    while pixel < following:
+                        sums[0] = sums[1] = sums[2] = sums[3] = 0.0
+                        if in0:
+                            _add(base0 + pixel, w00, w01, sigma, emission_code, normal_code,
+                                 emission, factor, highlight, grey, sums)
+                        if in1:
+                            _add(base1 + pixel, w10, w11, sigma, emission_code, normal_code,
+                                 emission, factor, highlight, grey, sums)
+                        taken[r] += 1
+                        ext = sums[0]
+                        if ext > 0.0:
+                            # Segment opacity (eq 1.4) and colour (eq 1.9), composited front to
+                            # back (eqs 1.7-1.8).
+                            alpha = -math.expm1(-ext * length)
+                            scale = alpha / ext
+                            cr = sums[1] * scale
+                            cg = cr if grey else sums[2] * scale
+                            cb = cr if grey else sums[3] * scale
+                            remaining = 1.0 - inter[row, pixel, 3]
+                            inter[row, pixel, 0] += remaining * cr
+                            inter[row, pixel, 1] += remaining * cg
+                            inter[row, pixel, 2] += remaining * cb
+                            inter[row, pixel, 3] += remaining * alpha
+                            if inter[row, pixel, 3] >= threshold:
+                                links[r, pixel] = pixel + 1
+                                opaque[r] += 1
+                        pixel = _open(links, r, pixel + 1)
+                    pos = following
+        for r in range(rows):
+            counts[first_row + r] = taken[r]

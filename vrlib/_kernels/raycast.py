@@ -21,6 +21,7 @@ from vrlib._kernels._jit import jit, parallel_jit
 from vrlib._kernels.camera import pixel_ray, ray_box
 from vrlib._kernels.filters import CUBIC, MAX_TAPS, TENT
 from vrlib._kernels.sampling import gradient, reconstruct, separable4, tricubic, trilinear
+from vrlib._kernels.shading import phong
 from vrlib._kernels.tables import interpolate_channel, lookup, piecewise_linear
 
 
@@ -205,7 +206,7 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, camera, heigh
                     if grey and not by_gradient:
                         cr = cg = cb = alpha  # white emission, no shading: colour = opacity
                     else:
-                        gx_ = gy_ = gz_ = norm = 0.0
+                        gx_ = gy_ = gz_ = 0.0
                         if shade or by_gradient:
                             gx_, gy_, gz_ = gradient(data, offset, gshape, ux, uy, uz, fkind,
                                                      fp0, fp1, fp2, radius, ntaps, wx, wy, wz,
@@ -213,9 +214,9 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, camera, heigh
                             gx_ *= inv[0]
                             gy_ *= inv[1]
                             gz_ *= inv[2]
-                            norm = math.sqrt(gx_ * gx_ + gy_ * gy_ + gz_ * gz_)
                         if by_gradient:
                             # Density times g(|grad F|): alpha = 1 - (1 - alpha)^g (eq 1.4).
+                            norm = math.sqrt(gx_ * gx_ + gy_ * gy_ + gz_ * gz_)
                             g = piecewise_linear(ramp_x, ramp_y, norm)
                             if not g > 0.0:
                                 continue
@@ -228,21 +229,8 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, camera, heigh
                                 lx, ly, lz = -d[0], -d[1], -d[2]
                             else:
                                 lx, ly, lz = light[0], light[1], light[2]
-                            # Half-vector of the light and the direction to the eye (-d).
-                            hx, hy, hz = lx - d[0], ly - d[1], lz - d[2]
-                            hn = math.sqrt(hx * hx + hy * hy + hz * hz)
-                            if hn > 0.0:
-                                hx, hy, hz = hx / hn, hy / hn, hz / hn
-                            else:
-                                hx, hy, hz = lx, ly, lz
-                            if norm > 0.0:
-                                ndotl = abs(gx_ * lx + gy_ * ly + gz_ * lz) / norm
-                                ndoth = abs(gx_ * hx + gy_ * hy + gz_ * hz) / norm
-                            else:
-                                ndotl = 1.0
-                                ndoth = 1.0
-                            factor = ka + kd * ndotl
-                            spec = ks * ndoth**shininess
+                            factor, spec = phong(gx_, gy_, gz_, lx, ly, lz, d[0], d[1], d[2],
+                                                 ka, kd, ks, shininess)
                             er = emit_tab[i, 0] + w * (emit_tab[i + 1, 0] - emit_tab[i, 0])
                             eg = emit_tab[i, 1] + w * (emit_tab[i + 1, 1] - emit_tab[i, 1])
                             eb = emit_tab[i, 2] + w * (emit_tab[i + 1, 2] - emit_tab[i, 2])

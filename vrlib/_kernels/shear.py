@@ -224,30 +224,57 @@ def shear_slices(slices, order, scale, di, dj, fraction, fkind, fp0, fp1, fp2, r
         counts[big_j] = done
 
 
-@parallel_jit
-def warp(inter, homography, out):
-    """The 2-D warp: ``out[r, c]`` is ``inter`` sampled bilinearly at ``(I, J) = (A, B) / D``
-    with ``(A, B, D) = homography @ (c, r, 1)`` (transparent outside, or where ``D <= 0``: the
-    pixel's ray never meets the intermediate image's plane)."""
-    height, width = out.shape[0], out.shape[1]
+@jit(inline="always")
+def _warp_pixel(inter, x, y, out, row, c):
+    """``out[row, c]`` = ``inter`` sampled bilinearly at ``(x, y)``, clipped to [0, 1];
+    transparent outside it, or where all four neighbours are (colours are premultiplied)."""
     n_j, n_i = inter.shape[0], inter.shape[1]
-    m = homography
-    for row in prange(height):
-        for c in range(width):
-            for ch in range(4):
-                out[row, c, ch] = 0.0
-            d = m[2, 0] * c + m[2, 1] * row + m[2, 2]
-            if not d > 0.0:
-                continue
-            x = (m[0, 0] * c + m[0, 1] * row + m[0, 2]) / d
-            y = (m[1, 0] * c + m[1, 1] * row + m[1, 2]) / d
-            if not (x >= 0.0 and y >= 0.0 and x <= n_i - 1 and y <= n_j - 1):
-                continue
-            i = min(int(x), n_i - 2)
-            j = min(int(y), n_j - 2)
+    if x >= 0.0 and y >= 0.0 and x <= n_i - 1 and y <= n_j - 1:
+        i = min(int(x), n_i - 2)
+        j = min(int(y), n_j - 2)
+        if not (inter[j, i, 3] == 0.0 and inter[j, i + 1, 3] == 0.0
+                and inter[j + 1, i, 3] == 0.0 and inter[j + 1, i + 1, 3] == 0.0):
             tx = x - i
             ty = y - j
             for ch in range(4):
                 top = (1 - tx) * inter[j, i, ch] + tx * inter[j, i + 1, ch]
                 bottom = (1 - tx) * inter[j + 1, i, ch] + tx * inter[j + 1, i + 1, ch]
-                out[row, c, ch] = (1 - ty) * top + ty * bottom
+                out[row, c, ch] = min(max((1 - ty) * top + ty * bottom, 0.0), 1.0)
+            return
+    for ch in range(4):
+        out[row, c, ch] = 0.0
+
+
+@parallel_jit
+def _warp_affine(inter, m, out):
+    height, width = out.shape[0], out.shape[1]
+    for row in prange(height):
+        ax = m[0, 1] * row + m[0, 2]
+        ay = m[1, 1] * row + m[1, 2]
+        for c in range(width):
+            _warp_pixel(inter, m[0, 0] * c + ax, m[1, 0] * c + ay, out, row, c)
+
+
+@parallel_jit
+def _warp_projective(inter, m, out):
+    height, width = out.shape[0], out.shape[1]
+    for row in prange(height):
+        for c in range(width):
+            d = m[2, 0] * c + m[2, 1] * row + m[2, 2]
+            if d > 0.0:
+                _warp_pixel(inter, (m[0, 0] * c + m[0, 1] * row + m[0, 2]) / d,
+                            (m[1, 0] * c + m[1, 1] * row + m[1, 2]) / d, out, row, c)
+            else:
+                for ch in range(4):
+                    out[row, c, ch] = 0.0
+
+
+def warp(inter, homography, out):
+    """The 2-D warp: ``out[r, c]`` is ``inter`` sampled bilinearly at ``(I, J) = (A, B) / D``
+    with ``(A, B, D) = homography @ (c, r, 1)`` (transparent outside, or where ``D <= 0``: the
+    pixel's ray never meets the intermediate image's plane), clipped to [0, 1]. An affine
+    homography (orthographic views: ``D = 1``) takes no division."""
+    if homography[2, 0] == 0.0 and homography[2, 1] == 0.0 and homography[2, 2] == 1.0:
+        _warp_affine(inter, homography, out)
+    else:
+        _warp_projective(inter, homography, out)
