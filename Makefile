@@ -97,8 +97,8 @@ test-all: $(INSTALLED)
 		-k "naive_twin or bricks or test_filters or test_transfer or test_skipping"
 
 bench: $(INSTALLED)
-	@dpkg -s libvolpack1 >/dev/null 2>&1 || (apt-get update -qq && apt-get install -y -qq \
-		libvolpack1 >/dev/null) || echo "VolPack could not be installed: its comparison is skipped"
+	@dpkg -s libvolpack1-dev >/dev/null 2>&1 || (apt-get update -qq && apt-get install -y -qq \
+		libvolpack1 libvolpack1-dev >/dev/null) || echo "VolPack could not be installed: its comparisons are skipped"
 	$(PY) -m pytest benchmarks --benchmark-enable --benchmark-only --benchmark-columns=min,median,max,rounds
 	@for script in benchmarks/bench_*.py; do [ -e "$$script" ] || continue; \
 		echo "== $$script"; $(PY) "$$script"; done

@@ -23,7 +23,7 @@ from vrlib.filters import FILTERS, make_filter
 from vrlib.image import Image, RenderStats
 from vrlib.reference import render_reference
 from vrlib.render import METHODS, reference_image, render
-from vrlib.transfer import GradientOpacity, Glow, LookupTransfer, Phong, TransferFunction
+from vrlib.transfer import Glow, GradientOpacity, LookupTransfer, Phong, TransferFunction
 from vrlib.view import View
 from vrlib.volume import Volume
 

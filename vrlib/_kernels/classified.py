@@ -75,7 +75,8 @@ def composite_classified(run_ptr, run_start, run_end, run_voxel, sigma, emission
     """Composite the slices ``order`` (front to back) into ``inter[J, I] = (r, g, b, a)``.
 
     Slice ``k``'s sample for intermediate pixel ``(I, J)`` lies at column ``I + di[k]`` and row
-    ``J + dj[k]`` of the slice's ``n_j`` scanlines; scanline ``k * n_j + j`` holds runs
+    ``J + dj[k]`` of the slice's ``n_j`` scanlines and stands for a segment of ``length``
+    (half that for the first and last slices); scanline ``k * n_j + j`` holds runs
     ``run_ptr[.] .. run_ptr[. + 1] - 1`` of columns ``[run_start, run_end)`` whose voxels are
     stored from ``run_voxel + 1`` on, between two transparent guard voxels (so that a sample at
     a run's edge reads a zero neighbour without a test). A voxel's colour is
@@ -100,6 +101,8 @@ def composite_classified(run_ptr, run_start, run_end, run_voxel, sigma, emission
         sums = np.empty(4)
         for step in range(order.shape[0]):
             k = order[step]
+            # The end slices stand for half a spacing (the volume's box ends there).
+            seg = 0.5 * length if step == 0 or step == order.shape[0] - 1 else length
             s_i = math.floor(di[k])
             fi = di[k] - s_i
             before = 1 if fi > 0.0 else 0  # a voxel also feeds the pixel to its left
@@ -174,7 +177,7 @@ def composite_classified(run_ptr, run_start, run_end, run_voxel, sigma, emission
                         if ext > 0.0:
                             # Segment opacity (eq 1.4) and colour (eq 1.9), composited front to
                             # back (eqs 1.7-1.8).
-                            alpha = -math.expm1(-ext * length)
+                            alpha = 1.0 - math.exp(-ext * seg)
                             scale = alpha / ext
                             cr = sums[1] * scale
                             cg = cr if grey else sums[2] * scale
