@@ -275,7 +275,7 @@ class ClassifiedVolume:
             inter = np.zeros((height, width, 4))
             counts = np.zeros(height, np.int64)
             composite_classified(*encoded, n_j, order, di, dj, length, self._emission, factor,
-                                 highlight, self._grey, threshold, BAND,
+                                 highlight, self._grey, shading is not None, threshold, BAND,
                                  self._band_order(axis, dj, height), inter,
                                  counts)
             plane = volume.origin[axis] + kf * volume.spacing[axis]

@@ -69,12 +69,20 @@ def pareto():
     fig, ax = plt.subplots(figsize=(10, 5.5))
     for r in data["rows"]:
         size = {None: 40, 1.0: 25, 0.5: 45, 0.25: 70}[r["step"]]
-        ax.scatter(r["seconds"], r["rmse"], s=size, color=COLOURS[r["method"]],
-                   marker=MARKERS[r["filter"]], alpha=0.8, edgecolors="none")
-    front = sorted(data["front"], key=lambda r: r["seconds"])
-    ax.step([r["seconds"] for r in front], [r["rmse"] for r in front], where="post",
-            color="k", lw=1.0, label="Pareto front")
-    for p, marker in zip(data["peers"], ["X", "x", "h"], strict=False):
+        if r["method"] in COLOURS:
+            ax.scatter(r["seconds"], r["rmse"], s=size, color=COLOURS[r["method"]],
+                       marker=MARKERS[r["filter"]], alpha=0.8, edgecolors="none")
+        else:  # the classified shear-warp
+            ax.scatter(r["seconds"], r["rmse"], s=60, facecolors="none",
+                       edgecolors=COLOURS["shearwarp"], marker="s", lw=1.2)
+    for key, colour, style, label in [("front", "k", "-", "vrlib's Pareto front"),
+                                      ("front_all", "0.45", "--", "front over every point, "
+                                                                  "peers included")]:
+        front = sorted(data.get(key, []), key=lambda r: r["seconds"])
+        ax.step([r["seconds"] for r in front], [r["rmse"] for r in front], where="post",
+                color=colour, ls=style, lw=1.0, label=label)
+    timed = [p for p in data["peers"] if p["seconds"] is not None]
+    for p, marker in zip(timed, ["X", "x", "+", "h", "H"], strict=False):
         label = p["renderer"] + ("" if p["step"] is None else f", step {p['step']:g}")
         ax.scatter(p["seconds"], p["rmse"], s=90, color="k", marker=marker, label=label)
     ax.set_xscale("log")
@@ -83,6 +91,8 @@ def pareto():
     ax.set_ylabel("rmse against the reference")
     for method, colour in COLOURS.items():
         ax.scatter([], [], color=colour, label=method)
+    ax.scatter([], [], facecolors="none", edgecolors=COLOURS["shearwarp"], marker="s",
+               label="shearwarp, classified (vrlib.classify)")
     for filt, marker in MARKERS.items():
         ax.scatter([], [], color="0.4", marker=marker, label=filt)
     ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5))

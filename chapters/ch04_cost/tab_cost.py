@@ -7,6 +7,32 @@ from chapters.ch04_cost import _merged
 from chapters.common import figure_path, read_json, result_path, write_csv, write_json
 
 
+def _config(r):
+    step = "" if r["step"] is None else f", step {r['step']:g}"
+    return f"{r['method']}, {r['filter']}{step}"
+
+
+def peer_row(p):
+    """One peer point against vrlib's configurations (``run_pareto.dominance``)."""
+    name = p["renderer"] + ("" if p["step"] is None else f", step {p['step']:g}")
+    if p["seconds"] is None:
+        return [name, "-", f"{p['rmse']:.2e}", "-", "-", "-", p.get("note", "not timed")]
+    if p.get("dominated_by"):
+        r = p["dominated_by"]
+        return [name, f"{p['seconds']:.4f}", f"{p['rmse']:.2e}", _config(r),
+                f"{r['seconds']:.4f}", f"{r['rmse']:.2e}",
+                f"dominated: {p['seconds'] / r['seconds']:.1f}x faster, "
+                f"{p['rmse'] / r['rmse']:.1f}x more accurate"]
+    if p.get("closest"):
+        r = p["closest"]
+        return [name, f"{p['seconds']:.4f}", f"{p['rmse']:.2e}", _config(r),
+                f"{r['seconds']:.4f}", f"{r['rmse']:.2e}",
+                f"not dominated: vrlib's fastest at least as accurate is "
+                f"{p['slower_by']:.1f}x slower"]
+    return [name, f"{p['seconds']:.4f}", f"{p['rmse']:.2e}", "-", "-", "-",
+            "not dominated: no vrlib configuration is as accurate"]
+
+
 def main():
     records = _merged.machines(__file__)
     first = records[0]
@@ -54,8 +80,13 @@ def main():
               [[r["method"], r["filter"], "-" if r["step"] is None else f"{r['step']:g}",
                 f"{r['seconds']:.4f}", f"{r['rmse']:.2e}"] for r in pareto["front"]]
               + [[p["renderer"], "trilinear" if "VTK" in p["renderer"] else "-",
-                  "-" if p["step"] is None else f"{p['step']:g}", f"{p['seconds']:.4f}",
+                  "-" if p["step"] is None else f"{p['step']:g}",
+                  "-" if p["seconds"] is None else f"{p['seconds']:.4f}",
                   f"{p['rmse']:.2e}"] for p in pareto["peers"]])
+    write_csv(figure_path(__file__, "peers_dominated.csv"),
+              ["peer", "seconds", "rmse", "vrlib configuration", "its seconds", "its rmse",
+               "verdict"],
+              [peer_row(p) for p in pareto["peers"]])
     skips = read_json(result_path(__file__, "skips.json"))
     write_csv(figure_path(__file__, "skips.csv"),
               ["scene", "visible voxels", "method", "skip", "speedup", "largest image change"],
