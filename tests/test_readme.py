@@ -55,6 +55,14 @@ def test_readme_python_example_runs(tmp_path, monkeypatch, capsys):
     assert (tmp_path / "blob.png").read_bytes()[:4] == b"\x89PNG"
 
 
+def test_readme_classified_example_runs(capsys):
+    """The classify-once example renders its twelve frames (speed is the benchmarks' business:
+    the line it prints only says each frame took under a second)."""
+    exec(compile(blocks("python")[2], "README.md", "exec"), {})
+    count = capsys.readouterr().out.strip().splitlines()[-1].split()[0]
+    assert count == "12"
+
+
 def test_readme_pictures_are_what_their_commands_make(tmp_path):
     import imageio.v3 as iio
 
