@@ -48,6 +48,22 @@ def test_render_npy_matches_the_python_api(tmp_path):
     np.testing.assert_array_equal(np.load(out), expected.rgba)
 
 
+def test_render_classified_matches_the_python_api(tmp_path):
+    """``--classified`` is :func:`vrlib.classify` and its render, shading included."""
+    import data_gen
+
+    out = tmp_path / "blob.npy"
+    done = run("render", "gaussian-blob:20:sigma=0.3", "--classified", "--shade", "--size",
+               "16", "--azimuth", "10", "--elevation", "5", "-o", str(out))
+    assert done.returncode == 0, done.stderr
+    assert "classified shear-warp" in done.stdout
+    vol = data_gen.make_field("gaussian-blob", sigma=0.3).sample(20)
+    view = vrlib.View.orbit(azimuth=10, elevation=5, size=16, radius=vol.bounding_radius,
+                            center=vol.center)
+    expected = vrlib.classify(vol, vrlib.Glow(1.0, shading=vrlib.Phong())).render(view)
+    np.testing.assert_array_equal(np.load(out), expected.rgba)
+
+
 def test_render_reads_files(tmp_path):
     data = np.zeros((8, 8, 8), np.uint8)
     data[2:6, 2:6, 2:6] = 200
@@ -74,6 +90,8 @@ def test_render_reads_files(tmp_path):
     (["render", "missing.raw", "-o", "x.png"], "volume file not found"),
     (["render", "marschner-lobb:17", "--projection", "perspective", "--method", "shear3",
       "-o", "x.png"], "orthographic only"),
+    (["render", "marschner-lobb:17", "--projection", "perspective", "--classified",
+      "-o", "x.png"], "orthographic views only"),
 ])
 def test_bad_input_exits_2_with_one_line(tmp_path, args, message):
     done = run(*args, cwd=tmp_path)

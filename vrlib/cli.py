@@ -149,13 +149,20 @@ def cmd_render(args):
         raise UsageError(f"output must end in .png or .npy, got {args.output!r}")
     volume, _ = load_volume(args.volume, shape=args.shape, dtype=args.dtype)
     view = make_view(args, volume)
-    seconds, img = measure(partial(
-        vrlib.render, volume, view, method=args.method, filter=args.filter,
-        transfer=make_transfer(args.transfer, args.shade)(volume), step=args.step),
-        repeats=1, warmup=False)
+    transfer = make_transfer(args.transfer, args.shade)(volume)
+    if args.classified:
+        if view.is_perspective:
+            raise UsageError("--classified renders orthographic views only (as VolPack)")
+        scene = vrlib.classify(volume, transfer)
+        seconds, img = measure(partial(scene.render, view), repeats=1, warmup=False)
+        what = f"classified shear-warp (classified in {scene.seconds:.3f} s)"
+    else:
+        seconds, img = measure(partial(
+            vrlib.render, volume, view, method=args.method, filter=args.filter,
+            transfer=transfer, step=args.step), repeats=1, warmup=False)
+        what = f"{args.method}/{args.filter}"
     img.save(args.output, bits=args.bits)
-    print(f"{args.output}: {view.width}x{view.height} {args.method}/{args.filter} "
-          f"in {seconds:.3f} s")
+    print(f"{args.output}: {view.width}x{view.height} {what} in {seconds:.3f} s")
 
 
 def _errors(img, ref):
@@ -282,6 +289,9 @@ def parser():
     _add_scene(render)
     render.add_argument("--method", default="raycast",
                         help="raycast, splat, shear3, shear2 or shearwarp (default raycast)")
+    render.add_argument("--classified", action="store_true",
+                        help="classify once and render by shear-warp as VolPack does (takes "
+                             "--shade; --method, --filter and --step do not apply)")
     render.add_argument("--bits", type=int, default=8, choices=[8, 16], help="PNG bit depth")
     render.add_argument("-o", "--output", required=True, help="output .png or .npy")
     render.set_defaults(run=cmd_render)

@@ -91,7 +91,9 @@ def render(volume, view, *, method="raycast", filter="trilinear", transfer=None,
     ((8, 8), True)
     """
     if not isinstance(volume, Volume):
-        raise TypeError(f"volume must be a vrlib.Volume, got {type(volume).__name__}")
+        hint = ("; a ClassifiedVolume renders with its own .render(view)"
+                if type(volume).__name__ == "ClassifiedVolume" else "")
+        raise TypeError(f"volume must be a vrlib.Volume, got {type(volume).__name__}{hint}")
     validate.choice("method", method, tuple(METHODS))
     filt, transfer, step, early_termination = render_arguments(view, filter, transfer, step,
                                                                early_termination)
