@@ -18,7 +18,9 @@ INSTALLED := $(VENV)/.installed
 # Sizes of the chapter experiments: default (minutes on 2 cores) or full (thesis scale).
 PROFILE ?= default
 export VRLIB_PROFILE := $(PROFILE)
-export NUMBA_CACHE_DIR := $(CURDIR)/build/numba
+# numba's cache is invalidated when a kernel's own file changes, not when a helper it calls
+# from another file does: one cache per version of the kernel sources, so none goes stale.
+export NUMBA_CACHE_DIR := $(CURDIR)/build/numba/$(shell cat vrlib/_kernels/*.py | sha1sum | cut -c1-12)
 # numba's default OpenMP layer kills a child forked after a parallel call; workqueue does not.
 export NUMBA_THREADING_LAYER := workqueue
 export MPLBACKEND := Agg

@@ -280,10 +280,10 @@ class ClassifiedVolume:
                                  counts)
             plane = volume.origin[axis] + kf * volume.spacing[axis]
             out = np.empty(view.shape + (4,))
-            warp(inter, warp_homography(view, volume, axis, plane, (oi, oj)), out)
+            warp(inter, warp_homography(view, volume, axis, plane, (oi, oj)), out, self._grey)
             taken = int(counts.sum())
             stats = RenderStats(samples=taken, operations=taken * 40 + out.size * 8,
                                 bytes=int(sum(a.nbytes for a in encoded) + inter.nbytes
                                           + out.nbytes),
                                 seconds=time.perf_counter() - start, voxels=taken)
-        return Image(out, stats)
+        return Image(out, stats, checked=False)  # the warp clipped it into [0, 1]

@@ -71,6 +71,9 @@ class Image:
     rgba : array_like, shape (height, width, 4)
         Premultiplied colour and opacity, finite; alpha in [0, 1].
     stats : RenderStats, optional
+    checked : bool, default True
+        False skips the finiteness and range checks: only for a renderer whose kernel has
+        clipped every value into [0, 1] (as the shear-warp warp does), never for other arrays.
 
     Examples
     --------
@@ -81,12 +84,15 @@ class Image:
     [1.0, 1.0, 1.0]
     """
 
-    def __init__(self, rgba, stats=None):
-        arr = validate.finite_array("rgba", rgba, ndim=3)
-        if arr.shape[2] != 4:
+    def __init__(self, rgba, stats=None, *, checked=True):
+        if not checked and isinstance(rgba, np.ndarray) and rgba.dtype == np.float64:
+            arr = rgba  # a renderer's kernel clipped it into [0, 1]: finite by construction
+        else:
+            arr = validate.finite_array("rgba", rgba, ndim=3)
+        if arr.ndim != 3 or arr.shape[2] != 4:
             raise ValueError(f"rgba must have shape (height, width, 4), got {arr.shape}")
         alpha = arr[..., 3]
-        if alpha.size and not (alpha.min() >= 0.0 and alpha.max() <= 1.0 + 1e-9):
+        if checked and alpha.size and not (alpha.min() >= 0.0 and alpha.max() <= 1.0 + 1e-9):
             raise ValueError("rgba alpha must lie in [0, 1]")
         self.rgba = arr
         self.stats = RenderStats() if stats is None else stats

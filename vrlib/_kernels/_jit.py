@@ -1,7 +1,9 @@
 """The one place where JIT compilation flags are set for every kernel.
 
 * ``cache=True``: compiled code is stored under ``NUMBA_CACHE_DIR`` (the Makefile points it at
-  ``build/numba``), so a second process loads instead of recompiling.
+  ``build/numba/<hash of the kernel sources>``), so a second process loads instead of
+  recompiling. numba notices when a kernel's own file changes but not when a helper it calls
+  from another file does; the hash in the folder's name keeps a stale kernel from loading.
 * ``fastmath`` stays off: results must not depend on how LLVM reassociates sums, and the same
   inputs must give bit-identical images for any thread count.
 * ``error_model="numpy"``: a division by zero gives inf/nan as in NumPy instead of raising

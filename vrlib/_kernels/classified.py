@@ -23,7 +23,7 @@ import numpy as np
 from numba import prange
 
 from vrlib._kernels._jit import jit, parallel_jit
-from vrlib._kernels.shading import phong
+from vrlib._kernels.shading import half_vector, phong_terms
 
 
 @parallel_jit
@@ -31,10 +31,12 @@ def shade_table(normals, light, direction, ka, kd, ks, shininess, factor, highli
     """Phong's ``factor`` and ``highlight`` for every normal code (``normals``: one unit vector
     per code, zero for "no gradient"), lit from ``light`` and seen along ``direction``:
     shading as a table lookup per voxel, rebuilt once per frame (VolPack's lookup shader)."""
+    hx, hy, hz = half_vector(light[0], light[1], light[2], direction[0], direction[1],
+                             direction[2])
     for n in prange(normals.shape[0]):
-        factor[n], highlight[n] = phong(normals[n, 0], normals[n, 1], normals[n, 2], light[0],
-                                        light[1], light[2], direction[0], direction[1],
-                                        direction[2], ka, kd, ks, shininess)
+        factor[n], highlight[n] = phong_terms(normals[n, 0], normals[n, 1], normals[n, 2],
+                                              light[0], light[1], light[2], hx, hy, hz, ka, kd,
+                                              ks, shininess)
 
 
 @jit(inline="always")
@@ -145,7 +147,20 @@ def composite_classified(run_ptr, run_start, run_end, run_voxel, sigma, emission
                 if fj > 0.0 and 0 <= r0 + 1 < n_j:
                     c1 = run_ptr[k * n_j + r0 + 1]
                     e1 = run_ptr[k * n_j + r0 + 2]
-                if c0 == e0 and c1 == e1:
+                # The pixels the two scanlines touch at all; none open there: nothing to do.
+                lo = width
+                hi = 0
+                if c0 < e0:
+                    lo = min(lo, run_start[c0] - s_i - before)
+                    hi = max(hi, run_end[e0 - 1] - s_i)
+                if c1 < e1:
+                    lo = min(lo, run_start[c1] - s_i - before)
+                    hi = max(hi, run_end[e1 - 1] - s_i)
+                hi = min(hi, width)
+                if lo >= hi:
+                    continue
+                pos = _open(links, r, max(lo, 0))
+                if pos >= hi:
                     continue
                 w00 = (1.0 - fi) * (1.0 - fj)
                 w01 = fi * (1.0 - fj)
@@ -154,13 +169,12 @@ def composite_classified(run_ptr, run_start, run_end, run_voxel, sigma, emission
                 # Walk the segments over which each stream stays inside one run or outside all:
                 # within one, a run's voxel for the pixel is base + pixel (VolPack's run
                 # merging), and the loop over the segment's open pixels keeps no books.
-                pos = 0
                 visited = 0
                 while True:
                     pos = _open(links, r, pos)  # past opaque pixels: their voxels are skipped
-                    if pos >= width:
+                    if pos >= hi:
                         break
-                    following = width
+                    following = hi
                     in0 = in1 = False
                     base0 = base1 = 0
                     while c0 < e0 and run_end[c0] - s_i <= pos:

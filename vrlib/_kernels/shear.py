@@ -225,9 +225,10 @@ def shear_slices(slices, order, scale, di, dj, fraction, fkind, fp0, fp1, fp2, r
 
 
 @jit(inline="always")
-def _warp_pixel(inter, x, y, out, row, c):
+def _warp_pixel(inter, x, y, out, row, c, grey):
     """``out[row, c]`` = ``inter`` sampled bilinearly at ``(x, y)``, clipped to [0, 1];
-    transparent outside it, or where all four neighbours are (colours are premultiplied)."""
+    transparent outside it, or where all four neighbours are (colours are premultiplied).
+    ``grey``: red, green and blue are equal, and only red is interpolated."""
     n_j, n_i = inter.shape[0], inter.shape[1]
     if x >= 0.0 and y >= 0.0 and x <= n_i - 1 and y <= n_j - 1:
         i = min(int(x), n_i - 2)
@@ -237,44 +238,50 @@ def _warp_pixel(inter, x, y, out, row, c):
             tx = x - i
             ty = y - j
             for ch in range(4):
+                if grey and (ch == 1 or ch == 2):
+                    continue
                 top = (1 - tx) * inter[j, i, ch] + tx * inter[j, i + 1, ch]
                 bottom = (1 - tx) * inter[j + 1, i, ch] + tx * inter[j + 1, i + 1, ch]
                 out[row, c, ch] = min(max((1 - ty) * top + ty * bottom, 0.0), 1.0)
+            if grey:
+                out[row, c, 1] = out[row, c, 0]
+                out[row, c, 2] = out[row, c, 0]
             return
     for ch in range(4):
         out[row, c, ch] = 0.0
 
 
 @parallel_jit
-def _warp_affine(inter, m, out):
+def _warp_affine(inter, m, out, grey):
     height, width = out.shape[0], out.shape[1]
     for row in prange(height):
         ax = m[0, 1] * row + m[0, 2]
         ay = m[1, 1] * row + m[1, 2]
         for c in range(width):
-            _warp_pixel(inter, m[0, 0] * c + ax, m[1, 0] * c + ay, out, row, c)
+            _warp_pixel(inter, m[0, 0] * c + ax, m[1, 0] * c + ay, out, row, c, grey)
 
 
 @parallel_jit
-def _warp_projective(inter, m, out):
+def _warp_projective(inter, m, out, grey):
     height, width = out.shape[0], out.shape[1]
     for row in prange(height):
         for c in range(width):
             d = m[2, 0] * c + m[2, 1] * row + m[2, 2]
             if d > 0.0:
                 _warp_pixel(inter, (m[0, 0] * c + m[0, 1] * row + m[0, 2]) / d,
-                            (m[1, 0] * c + m[1, 1] * row + m[1, 2]) / d, out, row, c)
+                            (m[1, 0] * c + m[1, 1] * row + m[1, 2]) / d, out, row, c, grey)
             else:
                 for ch in range(4):
                     out[row, c, ch] = 0.0
 
 
-def warp(inter, homography, out):
+def warp(inter, homography, out, grey=False):
     """The 2-D warp: ``out[r, c]`` is ``inter`` sampled bilinearly at ``(I, J) = (A, B) / D``
     with ``(A, B, D) = homography @ (c, r, 1)`` (transparent outside, or where ``D <= 0``: the
     pixel's ray never meets the intermediate image's plane), clipped to [0, 1]. An affine
-    homography (orthographic views: ``D = 1``) takes no division."""
+    homography (orthographic views: ``D = 1``) takes no division; ``grey`` images (red, green
+    and blue equal) interpolate one colour channel."""
     if homography[2, 0] == 0.0 and homography[2, 1] == 0.0 and homography[2, 2] == 1.0:
-        _warp_affine(inter, homography, out)
+        _warp_affine(inter, homography, out, grey)
     else:
-        _warp_projective(inter, homography, out)
+        _warp_projective(inter, homography, out, grey)
