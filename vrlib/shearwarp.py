@@ -178,9 +178,10 @@ def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
     # The warp: where each pixel's ray meets the front slice, in intermediate coordinates.
     plane = volume.origin[axis] + kf * h[axis]
     out = np.empty(view.shape + (4,))
-    _kernel.warp(inter, warp_homography(view, volume, axis, plane, (oi, oj)), out)
+    grey = bool(np.all(tables[4] == 1.0))  # white emission: red, green and blue are equal
+    _kernel.warp(inter, warp_homography(view, volume, axis, plane, (oi, oj)), out, grey)
     resampled = int(counts.sum())
     stats = RenderStats(samples=resampled, operations=resampled * (2 * ntaps**2 + 12)
                         + out.size * 8, bytes=int(volume.data.nbytes + inter.nbytes + out.nbytes),
                         seconds=time.perf_counter() - start, voxels=resampled)
-    return Image(out, stats)
+    return Image(out, stats, checked=False)  # the warp clipped it into [0, 1]
