@@ -44,7 +44,7 @@ def start(camera):
             camera[CENTER + 2] - back * camera[FORWARD + 2])
 
 
-@jit
+@jit(inline="always")
 def pixel_ray(camera, height, width, r, c):
     """Origin and unit direction of the ray through pixel ``(r, c)``, as
     :meth:`vrlib.View.rays` computes them."""
@@ -95,7 +95,7 @@ def project(camera, height, width, x, y, z):
     return 0.5 * height - cy / camera[PIXEL], cx / camera[PIXEL] + 0.5 * width, depth
 
 
-@jit
+@jit(inline="always")
 def ray_box(o, d, lo, hi):
     """Parameters ``(t_in, t_out)`` where the ray ``o + t d`` crosses the box ``[lo, hi]``
     (``t_in >= t_out`` when it misses); ``o`` and ``d`` are 3-tuples."""

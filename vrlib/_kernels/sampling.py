@@ -21,7 +21,7 @@ from vrlib._kernels.filters import (
 )
 
 
-@jit
+@jit(inline="always")
 def clamp(i, n):
     """Index ``i`` clamped to ``[0, n - 1]`` (the volume extended by its border values)."""
     if i < 0:
@@ -31,7 +31,7 @@ def clamp(i, n):
     return i
 
 
-@jit
+@jit(inline="always")
 def _taps(fkind, fp0, fp1, fp2, radius, ntaps, u, w, dw=None):
     """First tap index for position ``u`` on one axis; fills its weights ``w`` (and their
     derivatives ``dw`` when given)."""
@@ -66,7 +66,7 @@ def reconstruct(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1, fp2, radius, 
     return value
 
 
-@jit
+@jit(inline="always")
 def trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz):
     """The tent filter's two taps per axis, unrolled (the common case, kept fast).
 
@@ -107,7 +107,7 @@ def trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz):
     return lerp_corners(d000, d001, d010, d011, d100, d101, d110, d111, tx, ty, tz)
 
 
-@jit
+@jit(inline="always")
 def lerp_corners(d000, d001, d010, d011, d100, d101, d110, d111, tx, ty, tz):
     """Trilinear interpolation of a cell's corners ``d_zyx`` at fractions ``(tx, ty, tz)``:
     along x, then y, then z."""
@@ -120,7 +120,7 @@ def lerp_corners(d000, d001, d010, d011, d100, d101, d110, d111, tx, ty, tz):
     return c0 + tz * (c1 - c0)
 
 
-@jit
+@jit(inline="always")
 def cubic_weights(t, b, c):
     """Mitchell-Netravali weights of the taps at offsets -1, 0, 1, 2 from a point at fraction
     ``t`` in [0, 1) past tap 0 (distances 1 + t, t, 1 - t, 2 - t)."""
@@ -129,7 +129,7 @@ def cubic_weights(t, b, c):
             cubic_piece(near, 1.0 - t) / 6.0, cubic_piece(far, 2.0 - t) / 6.0)
 
 
-@jit
+@jit(inline="always")
 def tricubic(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz, b, c):
     """A Mitchell-Netravali (B, C) cubic's 4 x 4 x 4 taps; arguments as for
     :func:`trilinear`."""
@@ -141,7 +141,7 @@ def tricubic(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz, b, c):
                      cubic_weights(uz - iz, b, c))
 
 
-@jit
+@jit(inline="always")
 def _four_weights(fkind, fp0, fp1, fp2, u, first):
     if fkind == GAUSSIAN:
         # exp(-(d - a)^2 / 2s^2) = exp(-d^2 / 2s^2) exp(d / s^2)^a exp(-a^2 / 2s^2): two
@@ -176,7 +176,7 @@ def separable4(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz, fkind, fp0, fp
                      _four_weights(fkind, fp0, fp1, fp2, uz, fz))
 
 
-@jit
+@jit(inline="always")
 def four_taps(flat, nx, nxy, oz, oy, ox, gz, gy, gx, fx, fy, fz, wx, wy, wz):
     """Sum of 4 x 4 x 4 samples from global index ``(fx, fy, fz)`` on, weighted by the
     4-tuples ``wx, wy, wz``, unrolled along x and reading from one base index inside the

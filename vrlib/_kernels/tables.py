@@ -10,7 +10,7 @@ from __future__ import annotations
 from vrlib._kernels._jit import jit
 
 
-@jit
+@jit(inline="always")
 def lookup(x, n):
     """Left table entry and weight for grid position ``x`` (clamped to a table of ``n``)."""
     if not x > 0.0:  # also catches NaN
