@@ -23,7 +23,6 @@ import functools
 import math
 
 import numpy as np
-from scipy.spatial import ConvexHull
 
 from vrlib import validate
 from vrlib.filters import make_filter
@@ -133,6 +132,8 @@ def feature_error(filt, ratio, *, dims=1):
 
 def _hull(points):
     """The vertices of the convex hull of 2-D ``points`` (all of them if they are collinear)."""
+    from scipy.spatial import ConvexHull  # a quarter of a second to import: only when needed
+
     try:
         return points[ConvexHull(points).vertices]
     except Exception:  # degenerate (collinear) sets: scipy's Qhull refuses them

@@ -31,7 +31,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy import special
 
 from vrlib import validate
 from vrlib._kernels import filters as _k
@@ -368,6 +367,8 @@ class Gaussian(Filter):
         # exp(-s^2 w^2 / 2) * erf(z) overflows for large w; use erf(z) = 1 - exp(-z^2) w(iz).
         # exp(-s^2w^2/2 - z^2) = exp(-r^2/2s^2 - i r w), so the product stays bounded.
         gauss = np.exp(-0.5 * (s * w) ** 2)
+        from scipy import special  # imported on first use: it slows `import vrlib` down
+
         tail = np.exp(-0.5 * (r / s) ** 2 - 1j * r * w) * special.wofz(1j * z)
         value = (gauss - tail).real
         return value * s * math.sqrt(2.0 * math.pi) / self._norm

@@ -11,7 +11,6 @@ the standard metrics so that a conclusion can be checked for dependence on the c
 from __future__ import annotations
 
 import numpy as np
-from skimage.metrics import structural_similarity
 
 from vrlib import validate
 from vrlib.image import Image
@@ -91,6 +90,8 @@ def ssim(a, b, *, data_range=1.0):
     if min(a.shape[:2]) < 7:
         raise ValueError(f"ssim needs images of at least 7 x 7 pixels, got {a.shape[:2]}")
     channel_axis = -1 if a.ndim == 3 else None
+    from skimage.metrics import structural_similarity  # slow to import: on first use
+
     return float(structural_similarity(a, b, data_range=peak, channel_axis=channel_axis))
 
 
