@@ -61,6 +61,17 @@ def test_early_termination_and_min_opacity_follow_the_twin(blobs):
     assert 0 < stored < np.count_nonzero(blobs.data > 0)
 
 
+def test_nothing_visible_renders_a_blank_image():
+    """An all-transparent classification (VolPack 1.0b3 does not return from rendering one)."""
+    view = VIEWS[0]
+    for volume, low in ((vrlib.Volume(np.zeros((5, 6, 7))), 0.0),
+                        (vrlib.Volume(np.ones((5, 6, 7))), 0.99)):
+        scene = vrlib.classify(volume, vrlib.Glow(1.0, shading=vrlib.Phong()), min_opacity=low)
+        image = scene.render(view)
+        assert image.shape == view.shape and not image.rgba.any()
+        assert set(scene.stored_voxels.values()) == {0}
+
+
 def test_images_do_not_depend_on_the_thread_count(blobs):
     scene = vrlib.classify(blobs, TRANSFERS["colour, shaded, by gradient"])
     view = VIEWS[0]
