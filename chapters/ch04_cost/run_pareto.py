@@ -49,10 +49,10 @@ def dominance(rows, peer):
     beats = [r for r in rows if r["seconds"] < peer["seconds"] and r["rmse"] < peer["rmse"]]
     if beats:
         best = min(beats, key=lambda r: r["seconds"])
-        return {"dominated_by": best, "slower_by": None}
+        return {"dominated_by": best, "closest": None, "slower_by": None}
     accurate = [r for r in rows if r["rmse"] <= peer["rmse"]]
     if not accurate:
-        return {"dominated_by": None, "slower_by": None}
+        return {"dominated_by": None, "closest": None, "slower_by": None}
     best = min(accurate, key=lambda r: r["seconds"])
     return {"dominated_by": None, "closest": best, "slower_by": best["seconds"] / peer["seconds"]}
 
@@ -103,7 +103,8 @@ def main():
             peers.append({"renderer": name, "step": None, "seconds": seconds,
                           "rmse": vrlib.metrics.rmse(vp.alpha(), ref)})
             vp.close()
-    for peer in peers:
+    for peer in peers:  # every peer has the keys (None where untimed): the report reads them
+        peer.update({"dominated_by": None, "closest": None, "slower_by": None})
         if peer["seconds"] is not None:
             peer.update(dominance(rows, peer))
     timed = rows + [p for p in peers if p["seconds"] is not None]
