@@ -21,7 +21,7 @@ def peer_row(p):
         r = p["dominated_by"]
         return [name, f"{p['seconds']:.4f}", f"{p['rmse']:.2e}", _config(r),
                 f"{r['seconds']:.4f}", f"{r['rmse']:.2e}",
-                f"dominated: {p['seconds'] / r['seconds']:.1f}x faster, "
+                f"dominated: vrlib's is {p['seconds'] / r['seconds']:.1f}x faster and "
                 f"{p['rmse'] / r['rmse']:.1f}x more accurate"]
     if p.get("closest"):
         r = p["closest"]
