@@ -65,6 +65,24 @@ def test_every_rank_count_equals_the_serial_render(ranks):
 
 
 @pytest.mark.mpi
+@pytest.mark.slow
+@pytest.mark.parametrize("ranks", [3, 4])
+def test_shading_and_gradient_opacity_equal_the_serial_render(ranks):
+    """Gradients read the same taps as values (the filter's derivative), so a brick's ghost
+    samples serve both: shaded, gradient-classified images equal the serial render to 1e-6 for
+    every compositor and balance. (``make test`` checks the same on one rank of four bricks,
+    in process.)"""
+    config = {"field": "marschner-lobb", "n": 25, "size": 32, "filters": ["trilinear",
+                                                                           "catmull-rom"],
+              "views": [{"azimuth": 35, "elevation": 25},
+                        {"azimuth": -120, "elevation": -40, "projection": "perspective"}],
+              "shade": True, "gradient_opacity": [[0.5, 3.0], [0.2, 1.0]], "cases": CASES}
+    done, _ = launch("render.py", ranks, json.dumps(config))
+    assert done.returncode == 0, done.stderr
+    check_results(json.loads(done.stdout.strip().splitlines()[-1])["results"])
+
+
+@pytest.mark.mpi
 def test_ranks_with_nothing_to_show_take_part():
     """Zoomed in on one corner, several of 8 bricks fall off the screen: their ranks draw
     nothing, yet compositing completes and matches the serial render. Under direct send they
@@ -137,6 +155,23 @@ def test_one_rank_in_process_equals_serial(compositing, balance):
     serial = vrlib.render(field.sample(17), view, filter="catmull-rom", early_termination=1.0)
     assert np.abs(frame.image.rgba - serial.rgba).max() < TOLERANCE
     assert frame.bytes_sent().sum() == 0 and frame.imbalance() == 1.0
+
+
+@pytest.mark.parametrize("projection", ["orthographic", "perspective"])
+def test_shaded_bricks_in_process_equal_serial(projection):
+    """Four bricks on one rank, shaded and classified by gradient magnitude: the gradients at
+    the bricks' faces read the ghost samples, and the image equals the serial render."""
+    field = data_gen.make_field("marschner-lobb")
+    view = vrlib.View.orbit(azimuth=35, elevation=25, size=24, projection=projection)
+    transfer = vrlib.Glow(2.0, shading=vrlib.Phong(specular=0.3),
+                          gradient_opacity=vrlib.GradientOpacity([0.5, 3.0], [0.2, 1.0]))
+    for filt in ("trilinear", "catmull-rom"):
+        frame = mpi.render_object(MPI.COMM_SELF, field, view, shape=17, filter=filt,
+                                  transfer=transfer, compositing="direct-send", balance="work")
+        serial = vrlib.render(field.sample(17), view, filter=filt, transfer=transfer,
+                              early_termination=1.0)
+        assert serial.alpha.max() > 0.3
+        assert np.abs(frame.image.rgba - serial.rgba).max() < TOLERANCE
 
 
 def test_image_partition_in_process_and_from_a_file(tmp_path):

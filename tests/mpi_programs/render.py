@@ -3,7 +3,9 @@
 Run as ``mpiexec -n P python render.py CONFIG_JSON``. CONFIG holds ``field`` (a data_gen name),
 ``params``, ``n`` (samples per axis), ``size`` (image), ``views`` (orbit keyword dicts),
 ``filters`` and ``cases`` (``[compositing, balance]`` pairs, or ``["image", null]``); the
-transfer function is ``Glow(glow)``, or with ``threshold`` a ramp that is transparent below it.
+transfer function is ``Glow(glow)``, or with ``threshold`` a ramp that is transparent below it;
+``shade`` adds Phong shading and ``gradient_opacity`` (``[magnitudes, factors]``) a gradient
+ramp.
 Rank 0 prints one JSON line: per case, the largest difference from the serial render, the
 bytes each rank sent per phase, and the samples per rank.
 """
@@ -21,11 +23,15 @@ from vrlib.parallel import mpi
 
 def main(comm, config):
     field = data_gen.make_field(config["field"], **config.get("params", {}))
-    transfer = vrlib.Glow(config.get("glow", 2.0))
+    extras = {"shading": vrlib.Phong(specular=0.3) if config.get("shade") else None,
+              "gradient_opacity": (vrlib.GradientOpacity(*config["gradient_opacity"])
+                                   if "gradient_opacity" in config else None)}
+    transfer = vrlib.Glow(config.get("glow", 2.0), **extras)
     if "threshold" in config:
         values = np.linspace(0.0, 1.0, 257)
         t = config["threshold"]
-        transfer = vrlib.LookupTransfer(8.0 * np.clip((values - t) / (1 - t), 0.0, 1.0))
+        transfer = vrlib.LookupTransfer(8.0 * np.clip((values - t) / (1 - t), 0.0, 1.0),
+                                        **extras)
     results = []
     for orbit in config["views"]:
         view = vrlib.View.orbit(size=config["size"], **orbit)

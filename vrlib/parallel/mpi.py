@@ -29,7 +29,7 @@ import numpy as np
 from mpi4py import MPI
 
 from vrlib import validate
-from vrlib.arguments import refuse_gradients, render_arguments
+from vrlib.arguments import render_arguments
 from vrlib.image import Image, RenderStats
 from vrlib.parallel import rects
 from vrlib.parallel.balance import BALANCE, visible_cells, visible_work, work_split
@@ -102,7 +102,6 @@ def _root(root, size):
 def _check(view, filter, transfer, step, compositing=None, balance=None,
            bricks_per_rank=1):
     filt, transfer, step, _ = render_arguments(view, filter, transfer, step)
-    refuse_gradients(transfer, "the parallel renderer")
     if compositing is not None:
         validate.choice("compositing", compositing, tuple(COMPOSITORS))
     if balance is not None:
@@ -130,7 +129,7 @@ def render_object(comm, source, view, *, shape=None, extent=None, filter="trilin
     shape : int or (int, int, int)
         Samples per axis (fields only).
     filter, transfer, step
-        As :func:`vrlib.render` (ray casting; unshaded transfer functions). Early ray
+        As :func:`vrlib.render` (ray casting; shading and gradient opacity included). Early ray
         termination is off, so the image equals the serial render's with
         ``early_termination=1``.
     compositing : str, default "binary-swap"
