@@ -2,12 +2,13 @@
 
 The volume is classified once (:mod:`vrlib.classified`): per principal axis, every scanline of
 every slice is run-length encoded into runs of visible voxels, each stored with its extinction
-``sigma`` (per world unit), an emission code and a normal code. A frame walks the intermediate
-image row by row; for each slice, front to back, the row's sample points lie between two voxel
-scanlines with the same bilinear weights for every point of the slice. Only the points that a
-visible voxel of either scanline touches are visited (the runs, merged), and of those only the
-pixels not yet opaque: skip links with path compression jump over runs of opaque pixels (the
-role of VolPack's run-length encoded intermediate image).
+``sigma`` (per world unit), an emission code and a normal code, between two transparent guard
+voxels. A frame walks bands of intermediate-image rows; for each slice, front to back, a row's
+sample points lie between two voxel scanlines with the same bilinear weights for every point
+of the slice. Only the points that a visible voxel of either scanline touches are visited (the
+runs, merged into segments), and of those only the pixels not yet opaque: skip links with path
+compression jump over runs of opaque pixels (the role of VolPack's run-length encoded
+intermediate image).
 
 A sample's extinction is the bilinear mix of its four voxels' ``sigma`` and its colour their
 extinction-weighted mix (opacity-weighted colour interpolation, Wittenbrink, Malzbender and
