@@ -236,6 +236,30 @@ def shear_naive(volume, view, filt, transfer, step, passes):
     return np.clip(image, 0.0, 1.0)
 
 
+def warp_naive(inter, volume, view, axis, q_axis, p_axis, kf, low):
+    """Shear-warp's 2-D warp by the book: ``inter`` (the intermediate image: columns along
+    ``q_axis``, rows along ``p_axis``, its pixel (0, 0) at plane coordinates ``low``) sampled
+    bilinearly where each pixel's ray meets the plane of slice ``kf``, transparent outside it,
+    clipped to [0, 1]."""
+    h = volume.spacing
+    height, width = inter.shape[:2]
+    origins, directions = view.rays()
+    plane = volume.origin[axis] + kf * volume.spacing[axis]
+    t = (plane - origins[..., axis]) / directions[..., axis]
+    points = origins + t[..., None] * directions
+    x = (points[..., q_axis] - volume.origin[q_axis]) / h[q_axis] - low[0]
+    y = (points[..., p_axis] - volume.origin[p_axis]) / h[p_axis] - low[1]
+    out = np.zeros(view.shape + (4,))
+    inside = (x >= 0) & (y >= 0) & (x <= width - 1) & (y <= height - 1)
+    i0 = np.clip(np.floor(x).astype(int), 0, width - 2)
+    j0 = np.clip(np.floor(y).astype(int), 0, height - 2)
+    tx, ty = (x - i0)[..., None], (y - j0)[..., None]
+    sample = ((1 - ty) * ((1 - tx) * inter[j0, i0] + tx * inter[j0, i0 + 1])
+              + ty * ((1 - tx) * inter[j0 + 1, i0] + tx * inter[j0 + 1, i0 + 1]))
+    out[inside] = sample[inside]
+    return np.clip(out, 0.0, 1.0)
+
+
 def shearwarp_naive(volume, view, filt, transfer):
     """Shear-warp by the book: the intermediate image lies on the front slice's plane at its
     resolution; each of its pixels follows its ray (parallel, or from the eye) through every
@@ -289,21 +313,7 @@ def shearwarp_naive(volume, view, filt, transfer):
                 colour = transfer.emission(np.array([value]))[0]
                 inter[big_j, big_i] += (1 - inter[big_j, big_i, 3]) * np.r_[colour * alpha,
                                                                               alpha]
-    origins, directions = view.rays()
-    plane = volume.origin[axis] + kf * volume.spacing[axis]
-    t = (plane - origins[..., axis]) / directions[..., axis]
-    points = origins + t[..., None] * directions
-    x = (points[..., q_axis] - volume.origin[q_axis]) / h[0] - low[0]
-    y = (points[..., p_axis] - volume.origin[p_axis]) / h[1] - low[1]
-    out = np.zeros(view.shape + (4,))
-    inside = (x >= 0) & (y >= 0) & (x <= width - 1) & (y <= height - 1)
-    i0 = np.clip(np.floor(x).astype(int), 0, width - 2)
-    j0 = np.clip(np.floor(y).astype(int), 0, height - 2)
-    tx, ty = (x - i0)[..., None], (y - j0)[..., None]
-    sample = ((1 - ty) * ((1 - tx) * inter[j0, i0] + tx * inter[j0, i0 + 1])
-              + ty * ((1 - tx) * inter[j0 + 1, i0] + tx * inter[j0 + 1, i0 + 1]))
-    out[inside] = sample[inside]
-    return np.clip(out, 0.0, 1.0)
+    return warp_naive(inter, volume, view, axis, q_axis, p_axis, kf, low)
 
 
 def classified_naive(volume, transfer, view, *, early_termination=1.0, min_opacity=0.0):
@@ -375,21 +385,7 @@ def classified_naive(volume, transfer, view, *, early_termination=1.0, min_opaci
         add = (1 - inter[..., 3])[..., None] * np.concatenate([rgb * alpha[..., None],
                                                                alpha[..., None]], -1)
         inter[live] += add[live]
-    origins, directions = view.rays()
-    plane = volume.origin[axis] + kf * volume.spacing[axis]
-    t = (plane - origins[..., axis]) / directions[..., axis]
-    points = origins + t[..., None] * directions
-    x = (points[..., q_axis] - volume.origin[q_axis]) / h[0] - low[0]
-    y = (points[..., p_axis] - volume.origin[p_axis]) / h[1] - low[1]
-    out = np.zeros(view.shape + (4,))
-    inside = (x >= 0) & (y >= 0) & (x <= width - 1) & (y <= height - 1)
-    i0 = np.clip(np.floor(x).astype(int), 0, width - 2)
-    j0 = np.clip(np.floor(y).astype(int), 0, height - 2)
-    tx, ty = (x - i0)[..., None], (y - j0)[..., None]
-    sample = ((1 - ty) * ((1 - tx) * inter[j0, i0] + tx * inter[j0, i0 + 1])
-              + ty * ((1 - tx) * inter[j0 + 1, i0] + tx * inter[j0 + 1, i0 + 1]))
-    out[inside] = sample[inside]
-    return np.clip(out, 0.0, 1.0)
+    return warp_naive(inter, volume, view, axis, q_axis, p_axis, kf, low)
 
 
 #: Each method's naive twin as ``twin(volume, view, filt, transfer)``, at :func:`vrlib.render`'s

@@ -86,6 +86,12 @@ def decode_normals():
     return np.concatenate([n, np.zeros((1, 3))])
 
 
+def _slice_shape(volume, axis):
+    """``(slices, rows, columns)`` of ``volume.slices(axis)``, without making the copy that
+    slices along x need."""
+    return tuple(volume.shape[a] for a in _SLICE_ORDER[axis])
+
+
 @functools.cache
 def _normals():
     return decode_normals()
@@ -225,7 +231,7 @@ class ClassifiedVolume:
         scanlines)."""
         if axis not in self._line_runs:
             run_ptr = self.encoding(axis)[0]
-            n_k, n_j = self.volume.slices(axis).shape[:2]
+            n_k, n_j = _slice_shape(self.volume, axis)[:2]
             self._line_runs[axis] = np.diff(run_ptr).reshape(n_k, n_j).sum(axis=0) + 1.0
         runs = self._line_runs[axis]
         lines = np.clip(np.arange(height) + int(round(dj[dj.size // 2])), 0, runs.size - 1)
@@ -268,7 +274,7 @@ class ClassifiedVolume:
             start = time.perf_counter()
             _, di, dj, (oi, oj), (height, width), kf, _ = intermediate_plane(
                 volume, view, axis, ascending)
-            n_k, n_j = volume.slices(axis).shape[:2]
+            n_k, n_j = _slice_shape(volume, axis)[:2]
             order = np.arange(n_k) if ascending else np.arange(n_k)[::-1].copy()
             length = float(volume.spacing[axis] / abs(view.forward[axis]))
             factor, highlight = self._shade_tables(view, shading)

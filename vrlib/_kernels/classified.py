@@ -54,6 +54,23 @@ def _open(links, row, i):
 
 
 @jit(inline="always")
+def _stream(run_start, run_end, run_voxel, c, e, s_i, before, pos, following):
+    """One scanline's state at pixel ``pos``: its run cursor ``c`` (of runs ``c .. e - 1``)
+    advanced past the runs that end before it, whether a run covers it (a run
+    ``[start, end)`` covers the pixels ``[start - s_i - before, end - s_i)``), the base with
+    ``voxel = base + pixel`` there, and ``following`` cut to where that state ends."""
+    while c < e and run_end[c] - s_i <= pos:
+        c += 1
+    if c < e:
+        lo = run_start[c] - s_i - before
+        if lo <= pos:
+            return c, True, run_voxel[c] + 1 - run_start[c] + s_i, min(following,
+                                                                        run_end[c] - s_i)
+        return c, False, 0, min(following, lo)
+    return c, False, 0, following
+
+
+@jit(inline="always")
 def _opacity(depth):
     """``1 - exp(-depth)`` (eq 1.4); below 0.02, the faint segments of glowing volumes, from its
     Taylor series to the fifth power (error under 1e-13, without the cost of an exp)."""
@@ -176,28 +193,10 @@ def composite_classified(run_ptr, run_start, run_end, run_voxel, sigma, emission
                     if pos >= hi:
                         break
                     following = hi
-                    in0 = in1 = False
-                    base0 = base1 = 0
-                    while c0 < e0 and run_end[c0] - s_i <= pos:
-                        c0 += 1
-                    if c0 < e0:
-                        lo = run_start[c0] - s_i - before
-                        if lo <= pos:
-                            in0 = True
-                            base0 = run_voxel[c0] + 1 - run_start[c0] + s_i
-                            following = min(following, run_end[c0] - s_i)
-                        else:
-                            following = min(following, lo)
-                    while c1 < e1 and run_end[c1] - s_i <= pos:
-                        c1 += 1
-                    if c1 < e1:
-                        lo = run_start[c1] - s_i - before
-                        if lo <= pos:
-                            in1 = True
-                            base1 = run_voxel[c1] + 1 - run_start[c1] + s_i
-                            following = min(following, run_end[c1] - s_i)
-                        else:
-                            following = min(following, lo)
+                    c0, in0, base0, following = _stream(run_start, run_end, run_voxel, c0, e0,
+                                                        s_i, before, pos, following)
+                    c1, in1, base1, following = _stream(run_start, run_end, run_voxel, c1, e1,
+                                                        s_i, before, pos, following)
                     if not (in0 or in1):
                         pos = following
                         continue
