@@ -12,7 +12,8 @@ The axis order avoids bottlenecks (a small scale factor squeezes the data throug
 intermediate lattice and loses detail): ``w`` is the volume axis most parallel to the view,
 and of the two orders of the others the renderer takes the one whose smaller scale factor
 ``|a|`` or ``|e|`` is larger. ``method="shear3"``
-runs all three passes and composites along ``Z``. ``method="shear2"`` drops the third pass:
+runs all three passes and composites along ``Z``; its third pass runs along the rays, so it is
+fused with the compositing and no third volume is stored. ``method="shear2"`` drops the third pass:
 pass 3 only slides samples along their own ray and re-spaces them evenly, so the slices that
 pass 2 leaves on the image's rows and columns are composited in slice order directly, each a
 segment of the same length ``|i| ds`` (one global opacity correction). Both are affine, so
@@ -136,25 +137,31 @@ def _check(view, transfer):
 
 
 def _filled(first, last, length):
-    """For the next pass: each of its lines runs across the lines of this pass, and holds data
-    where this pass computed it. ``first[s, r] .. last[s, r]`` are the outputs this pass
-    computed on line ``(s, r)``; returns, for every ``(s, q)`` with ``q`` in ``[0, length)``,
-    the first and last ``r`` whose range covers ``q`` (``first > last`` where none does)."""
-    q = np.arange(length)
-    covered = (first[:, :, None] <= q) & (q <= last[:, :, None])  # [s, r, q]
-    any_r = covered.any(axis=1)
-    n_r = first.shape[1]
-    lo = np.where(any_r, covered.argmax(axis=1), n_r)
-    hi = np.where(any_r, n_r - 1 - covered[:, ::-1, :].argmax(axis=1), -1)
-    return lo.astype(np.int64), hi.astype(np.int64)
+    """Where the next pass's lines hold data (:func:`vrlib._kernels.shear.filled`)."""
+    lo = np.empty((first.shape[0], length), np.int64)
+    hi = np.empty_like(lo)
+    _kernel.filled(first, last, length, lo, hi)
+    return lo, hi
 
 
 def _run_pass(src, out, c0, c1, c2, offset, lo, hi, filt):
+    """Run one pass in the loop order that suits the arrays' memory layout: a pass is the same
+    with its outer axes ``s`` and ``r`` swapped (and ``c1``, ``c2`` with them), and its lines
+    advance together when ``r`` is the axis that lies contiguous in memory. The outputs do not
+    depend on the order."""
+    swap = src.strides[0] < src.strides[1]
+    if swap:
+        src, out, c1, c2 = src.transpose(1, 0, 2), out.transpose(1, 0, 2), c2, c1
+        lo, hi = lo.T, hi.T
+    across = src.strides[1] < src.strides[2] and out.strides[1] < out.strides[2]
     counts = np.zeros(out.shape[0], np.int64)
     first = np.empty(out.shape[:2], np.int64)
     last = np.empty(out.shape[:2], np.int64)
-    _kernel.shear_pass(src, out, c0, c1, c2, offset, lo, hi, *filt.code, filt.radius,
-                       filt.taps, counts, first, last)
+    _kernel.shear_pass(src, out, c0, c1, c2, offset, np.ascontiguousarray(lo),
+                       np.ascontiguousarray(hi), *filt.code, filt.radius, filt.taps, across,
+                       counts, first, last)
+    if swap:
+        first, last = first.T, last.T
     return int(counts.sum()), first, last
 
 
@@ -176,7 +183,9 @@ def _passes(volume, view, plan, filt, count, dtype):
         data, v1, plan.a, plan.b, plan.c, plan.t0, np.zeros((nw, nv), np.int64),
         np.full((nw, nv), nu - 1, np.int64), filt)
     lo, hi = _filled(first1, last1, view.width)  # pass 2 lines (w, X) run along v
-    v2 = np.zeros((nw, view.height, view.width), dtype)
+    # V2[w, Y, X] is stored as [Y, w, X]: the samples one image row needs lie together, for
+    # the last pass (shear3) or the compositing (shear2), which take an image row at a time.
+    v2 = np.zeros((view.height, nw, view.width), dtype).transpose(1, 0, 2)
     count["pass2"], first2, last2 = _run_pass(
         v1.transpose(0, 2, 1), v2.transpose(0, 2, 1), plan.e, plan.d, plan.f, plan.t1, lo, hi,
         filt)
@@ -234,20 +243,21 @@ def render_shear3(volume, view, *, filt, transfer, step, early_termination,
     dtype = _intermediate(intermediate, volume)
     start = time.perf_counter()
     ds, plan, count, (v2, first2, last2) = _first_passes(volume, view, filt, step, dtype)
-    v3 = np.zeros((plan.depth_samples, view.height, view.width), dtype)
-    # Pass 3 lines (Y, X) run along w: first2/last2 are indexed [w, X] over Y.
+    # Pass 3 runs along the rays: fused with compositing, no third volume is stored.
     lo, hi = _filled(first2.transpose(1, 0), last2.transpose(1, 0), view.height)  # [X, Y]
-    count["pass3"], _, _ = _run_pass(
-        v2.transpose(1, 2, 0), v3.transpose(1, 2, 0), plan.i, plan.g, plan.h, plan.t2,
-        np.ascontiguousarray(lo.T), np.ascontiguousarray(hi.T), filt)
-    largest = max(count["buffers"], v2.nbytes + v3.nbytes)
-    del v2
     tables = transfer.segment_table(ds, *reconstructed_range(volume, filt))
     out = np.zeros(view.shape + (4,))
+    resampled = np.zeros(view.height, np.int64)
     counts = np.zeros(view.height, np.int64)
     limits = np.array(volume.shape[::-1], float)[list(plan.order)] - 1.0
-    _kernel.composite_lattice(v3, np.linalg.inv(plan.matrix), plan.shift, limits, tables[0],
-                              tables[1], tables[2], tables[3], early_termination, out, counts)
+    _kernel.resample_composite(
+        v2.transpose(1, 2, 0), plan.i, plan.g, plan.h, plan.t2, np.ascontiguousarray(lo.T),
+        np.ascontiguousarray(hi.T), *filt.code, filt.radius, filt.taps, plan.depth_samples,
+        np.linalg.inv(plan.matrix), plan.shift, limits, *tables[:4], early_termination, out,
+        resampled, counts)
+    count["pass3"] = int(resampled.sum())
+    largest = max(count["buffers"], v2.nbytes)
+    del v2
     stats = _stats(volume, filt.taps, count, int(counts.sum()), time.perf_counter() - start,
                    largest)
     return Image(np.clip(out, 0.0, 1.0), stats)

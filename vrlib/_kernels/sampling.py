@@ -32,7 +32,7 @@ def clamp(i, n):
 
 
 @jit(inline="always")
-def _taps(fkind, fp0, fp1, fp2, radius, ntaps, u, w, dw=None):
+def filter_taps(fkind, fp0, fp1, fp2, radius, ntaps, u, w, dw=None):
     """First tap index for position ``u`` on one axis; fills its weights ``w`` (and their
     derivatives ``dw`` when given)."""
     first = int(math.floor(u - radius)) + 1
@@ -51,9 +51,9 @@ def reconstruct(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1, fp2, radius, 
     ``wx, wy, wz`` are scratch arrays of at least ``ntaps`` entries. The sum runs z, then y,
     then x, in a fixed order, so the result does not depend on the caller's threading.
     """
-    fx = _taps(fkind, fp0, fp1, fp2, radius, ntaps, ux, wx)
-    fy = _taps(fkind, fp0, fp1, fp2, radius, ntaps, uy, wy)
-    fz = _taps(fkind, fp0, fp1, fp2, radius, ntaps, uz, wz)
+    fx = filter_taps(fkind, fp0, fp1, fp2, radius, ntaps, ux, wx)
+    fy = filter_taps(fkind, fp0, fp1, fp2, radius, ntaps, uy, wy)
+    fz = filter_taps(fkind, fp0, fp1, fp2, radius, ntaps, uz, wz)
     value = 0.0
     for c in range(ntaps):
         kz = clamp(fz + c, gshape[0]) - offset[0]
@@ -215,9 +215,9 @@ def gradient(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1, fp2, radius, nta
     The derivative of the separable sum: one axis's weights replaced by the kernel's
     derivative. ``dx, dy, dz`` are scratch arrays like ``wx``.
     """
-    fx = _taps(fkind, fp0, fp1, fp2, radius, ntaps, ux, wx, dx)
-    fy = _taps(fkind, fp0, fp1, fp2, radius, ntaps, uy, wy, dy)
-    fz = _taps(fkind, fp0, fp1, fp2, radius, ntaps, uz, wz, dz)
+    fx = filter_taps(fkind, fp0, fp1, fp2, radius, ntaps, ux, wx, dx)
+    fy = filter_taps(fkind, fp0, fp1, fp2, radius, ntaps, uy, wy, dy)
+    fz = filter_taps(fkind, fp0, fp1, fp2, radius, ntaps, uz, wz, dz)
     gx = 0.0
     gy = 0.0
     gz = 0.0

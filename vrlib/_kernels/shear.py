@@ -5,7 +5,8 @@ A pass resamples along the last axis of its (possibly transposed) source: output
 ``pos = (q - offset - c1 r - c2 s) / c0`` (a scaled shear, eq. "x' = Ax + B" of the thesis's
 section 1.2), reconstructed with a 1-D filter whose taps are clamped at the line's ends. Only
 outputs whose ``pos`` lies within the line (widened by the filter's reach) are computed; the
-rest stay zero. The compositing kernels read the last intermediate volume along the view.
+rest stay zero. Three-pass shearing's last pass runs along the rays and is fused with its
+compositing; two-pass compositing reads the second intermediate volume along the view.
 """
 
 from __future__ import annotations
@@ -16,26 +17,65 @@ import numpy as np
 from numba import prange
 
 from vrlib._kernels._jit import jit, parallel_jit
-from vrlib._kernels.filters import weight
-from vrlib._kernels.sampling import clamp
+from vrlib._kernels.filters import CUBIC, MAX_TAPS, TENT, weight
+from vrlib._kernels.sampling import filter_taps, clamp, cubic_weights
 from vrlib._kernels.tables import lookup
+
+
+@jit(inline="always")
+def _line_taps(fkind, fp0, fp1, fp2, radius, ntaps, pos, w):
+    """First tap of position ``pos`` on a line, its ``ntaps`` weights in ``w``: closed forms for
+    the tent (2 taps) and the cubics (4 taps, the pieces evaluated once each), the filter's
+    definition tap by tap otherwise."""
+    if fkind == TENT:
+        first = int(math.floor(pos))
+        t = pos - first
+        w[0] = 1.0 - t
+        w[1] = t
+        return first
+    if fkind == CUBIC:
+        first = int(math.floor(pos)) - 1
+        w[0], w[1], w[2], w[3] = cubic_weights(pos - (first + 1), fp0, fp1)
+        return first
+    return filter_taps(fkind, fp0, fp1, fp2, radius, ntaps, pos, w)
+
+
+@jit(inline="always")
+def _resample(src, s, r, lo, hi, pos, fkind, fp0, fp1, fp2, radius, ntaps, w):
+    """Line ``src[s, r]`` (data on ``lo .. hi``) reconstructed at ``pos``; taps clamped to the
+    data only near its ends."""
+    first = _line_taps(fkind, fp0, fp1, fp2, radius, ntaps, pos, w)
+    acc = 0.0
+    if first >= lo and first + ntaps - 1 <= hi:
+        for a in range(ntaps):
+            acc += w[a] * src[s, r, first + a]
+    else:
+        for a in range(ntaps):
+            acc += w[a] * src[s, r, min(max(first + a, lo), hi)]
+    return acc
 
 
 @parallel_jit
 def shear_pass(src, out, c0, c1, c2, offset, line_lo, line_hi, fkind, fp0, fp1, fp2, radius,
-               ntaps, counts, out_first, out_last):
+               ntaps, across, counts, out_first, out_last):
     """One resampling pass (see the module docstring); ``counts[s]`` gets the outputs computed
     for outer index ``s``.
 
     Source line ``(s, r)`` holds data only on ``line_lo[s, r] .. line_hi[s, r]`` (the part an
     earlier pass filled); taps are clamped to it, and only outputs whose source lies within it,
     widened by the filter's reach, are computed: ``out_first[s, r] .. out_last[s, r]``.
+    With ``across``, the lines of one ``s`` advance together, output ``q`` of every line before
+    ``q + 1``: the order that reads and writes memory contiguously when the arrays are
+    transposed views whose ``r`` axis is the contiguous one. The outputs are the same.
     """
     n_s, n_r, n_q = out.shape
     n = src.shape[2]
     for s_index in prange(n_s):
         s = np.int64(s_index)
+        w = np.empty(MAX_TAPS)
         done = 0
+        q_lo = n_q
+        q_hi = -1
         for r in range(n_r):
             out_first[s, r] = 0
             out_last[s, r] = -1
@@ -47,23 +87,48 @@ def shear_pass(src, out, c0, c1, c2, offset, line_lo, line_hi, fkind, fp0, fp1, 
             # Output positions q = base + c0 pos whose source lies in [lo - reach, hi + reach].
             q_a = base + c0 * (lo - radius)
             q_b = base + c0 * (hi + radius)
-            q_first = max(0, int(math.ceil(min(q_a, q_b))))
-            q_last = min(n_q - 1, int(math.floor(max(q_a, q_b))))
-            out_first[s, r] = q_first
-            out_last[s, r] = q_last
-            for q in range(q_first, q_last + 1):
-                pos = (q - base) / c0
-                first = int(math.floor(pos - radius)) + 1
-                acc = 0.0
-                for a in range(ntaps):
-                    tap = min(max(first + a, lo), hi)
-                    acc += weight(fkind, fp0, fp1, fp2, pos - (first + a)) * src[s, r, tap]
-                out[s, r, q] = acc
-                done += 1
+            out_first[s, r] = max(0, int(math.ceil(min(q_a, q_b))))
+            out_last[s, r] = min(n_q - 1, int(math.floor(max(q_a, q_b))))
+            if out_first[s, r] > out_last[s, r]:
+                continue
+            done += out_last[s, r] - out_first[s, r] + 1
+            q_lo = min(q_lo, out_first[s, r])
+            q_hi = max(q_hi, out_last[s, r])
+            if across:
+                continue
+            for q in range(out_first[s, r], out_last[s, r] + 1):
+                out[s, r, q] = _resample(src, s, r, lo, hi, (q - base) / c0, fkind, fp0, fp1,
+                                         fp2, radius, ntaps, w)
+        if across:
+            for q in range(q_lo, q_hi + 1):
+                for r in range(n_r):
+                    if out_first[s, r] <= q <= out_last[s, r]:
+                        out[s, r, q] = _resample(
+                            src, s, r, max(0, line_lo[s, r]), min(n - 1, line_hi[s, r]),
+                            (q - (offset + c1 * r + c2 * s)) / c0, fkind, fp0, fp1, fp2,
+                            radius, ntaps, w)
         counts[s] += done
 
 
-@jit
+@parallel_jit
+def filled(first, last, length, lo, hi):
+    """For the next pass, whose lines run across this pass's: ``first[s, r] .. last[s, r]``
+    are the outputs this pass computed on line ``(s, r)``; ``lo[s, q]`` and ``hi[s, q]`` get,
+    for every ``q`` in ``[0, length)``, the first and last ``r`` whose range covers ``q``
+    (``lo = n_r``, ``hi = -1`` where none does)."""
+    n_s, n_r = first.shape
+    for s_index in prange(n_s):
+        s = np.int64(s_index)
+        for q in range(length):
+            lo[s, q] = n_r
+            hi[s, q] = -1
+        for r in range(n_r):
+            for q in range(max(0, first[s, r]), min(length - 1, last[s, r]) + 1):
+                lo[s, q] = min(lo[s, q], r)
+                hi[s, q] = max(hi[s, q], r)
+
+
+@jit(inline="always")
 def _over(value, fraction, tstart, tinv, alpha_tab, color_tab, buf, y, x):
     """Classify one sample from the segment table and composite it under ``buf[y, x]``
     (premultiplied RGBA; eqs 1.7-1.8, colour E alpha: eq 1.9). ``fraction`` is the sample's
@@ -86,19 +151,74 @@ def _over(value, fraction, tstart, tinv, alpha_tab, color_tab, buf, y, x):
     buf[y, x, 3] += remaining * alpha
 
 
+@jit(inline="always")
+def _inside_range(inverse, shift, limits, x, y, n):
+    """The ``z`` in ``[0, n)`` that can lie inside the volume on the lattice ray through
+    ``(x, y)``: where ``0 <= inverse @ ((x, y, z) - shift) <= limits`` on every axis, widened
+    by one sample (callers keep the exact test; this only bounds the loop)."""
+    z_lo = 0.0
+    z_hi = n - 1.0
+    for a in range(3):
+        u0 = inverse[a, 0] * (x - shift[0]) + inverse[a, 1] * (y - shift[1]) \
+            - inverse[a, 2] * shift[2]
+        slope = inverse[a, 2]
+        if slope == 0.0:
+            if u0 < 0.0 or u0 > limits[a]:
+                return 0, -1
+            continue
+        z0 = -u0 / slope
+        z1 = (limits[a] - u0) / slope
+        z_lo = max(z_lo, min(z0, z1))
+        z_hi = min(z_hi, max(z0, z1))
+    if z_lo > z_hi:
+        return 0, -1
+    return max(0, int(math.floor(z_lo)) - 1), min(n - 1, int(math.ceil(z_hi)) + 1)
+
+
 @parallel_jit
-def composite_lattice(vol, inverse, shift, limits, tstart, tinv, alpha_tab, color_tab,
-                      threshold, out, counts):
-    """Three-pass compositing: ``vol[Z, Y, X]`` lies on the image lattice; each pixel takes its
-    samples in order of increasing ``Z`` (front to back) into ``out`` (zeros). A sample belongs
-    to the volume when ``inverse @ ((X, Y, Z) - shift)`` lies within ``[0, limits]`` on every
-    axis."""
-    n_z, height, width = vol.shape
+def resample_composite(src, c0, c1, c2, offset, line_lo, line_hi, fkind, fp0, fp1, fp2, radius,
+                       ntaps, n_z, inverse, shift, limits, tstart, tinv, alpha_tab, color_tab,
+                       threshold, out, resampled, composited):
+    """Three-pass shearing's last pass fused with its compositing: the pass-3 line of pixel
+    ``(x, y)`` is that pixel's ray. ``src[y, x, w]`` is pass 2's output seen along the lines of
+    pass 3 (``line_lo .. line_hi`` filled, as for :func:`shear_pass`); lattice sample ``z`` of
+    the ray is the line resampled at ``(z - offset - c1 x - c2 y) / c0`` where :func:`shear_pass`
+    would compute it and 0 elsewhere, and it is composited front to back (increasing ``z``) into
+    ``out`` when it lies in the volume (the lattice sample ``inverse @ ((x, y, z) - shift)``
+    within ``[0, limits]``). The pixels of a row advance together (contiguous reads of ``src``); opaque pixels
+    take no more samples. ``resampled[y]`` and ``composited[y]`` count the work."""
+    height, width = out.shape[0], out.shape[1]
+    n = src.shape[2]
     for row_index in prange(height):
         y = np.int64(row_index)
-        done = 0
+        w = np.empty(MAX_TAPS)
+        z_first = np.empty(width, np.int64)
+        z_last = np.empty(width, np.int64)
+        q_first = np.empty(width, np.int64)
+        q_last = np.empty(width, np.int64)
+        row_lo = n_z
+        row_hi = -1
         for x in range(width):
-            for z in range(n_z):
+            z_first[x], z_last[x] = _inside_range(inverse, shift, limits, x, y, n_z)
+            q_first[x] = 0
+            q_last[x] = -1
+            lo = max(0, line_lo[y, x])
+            hi = min(n - 1, line_hi[y, x])
+            if lo <= hi:
+                base = offset + c1 * x + c2 * y
+                q_a = base + c0 * (lo - radius)
+                q_b = base + c0 * (hi + radius)
+                q_first[x] = max(0, int(math.ceil(min(q_a, q_b))))
+                q_last[x] = min(n_z - 1, int(math.floor(max(q_a, q_b))))
+            if z_first[x] <= z_last[x]:
+                row_lo = min(row_lo, z_first[x])
+                row_hi = max(row_hi, z_last[x])
+        taken = 0
+        done = 0
+        for z in range(row_lo, row_hi + 1):
+            for x in range(width):
+                if not z_first[x] <= z <= z_last[x] or out[y, x, 3] >= threshold:
+                    continue
                 inside = True
                 for a in range(3):
                     u = (inverse[a, 0] * (x - shift[0]) + inverse[a, 1] * (y - shift[1])
@@ -107,11 +227,16 @@ def composite_lattice(vol, inverse, shift, limits, tstart, tinv, alpha_tab, colo
                         inside = False
                 if not inside:
                     continue
+                value = 0.0
+                if q_first[x] <= z <= q_last[x]:
+                    value = _resample(src, y, x, max(0, line_lo[y, x]), min(n - 1, line_hi[y, x]),
+                                      (z - (offset + c1 * x + c2 * y)) / c0, fkind, fp0, fp1,
+                                      fp2, radius, ntaps, w)
+                    taken += 1
                 done += 1
-                _over(vol[z, y, x], 1.0, tstart, tinv, alpha_tab, color_tab, out, y, x)
-                if out[y, x, 3] >= threshold:
-                    break
-        counts[y] = done
+                _over(value, 1.0, tstart, tinv, alpha_tab, color_tab, out, y, x)
+        resampled[y] = taken
+        composited[y] = done
 
 
 @parallel_jit
@@ -121,14 +246,41 @@ def composite_slices(vol, front_to_back, inverse2, shift, limits, tstart, tinv, 
     rows and columns; each pixel composites the slices in view order, each a segment of the
     same length (the table's) but the first and last, which reach half as far into the volume.
     Sample ``(X, Y)`` of slice ``w`` belongs to the volume when
-    ``(u, v) = inverse2 @ ((X, Y) - shift[:2] - w shift[2:])`` lies within ``limits``."""
+    ``(u, v) = inverse2 @ ((X, Y) - shift[:2] - w shift[2:])`` lies within ``limits``. The
+    pixels of a row advance together, slice by slice (contiguous reads); each pixel visits only
+    the slices its ray can meet inside the volume."""
     n_w, height, width = vol.shape
     for row_index in prange(height):
         y = np.int64(row_index)
-        done = 0
+        w_first = np.empty(width, np.int64)
+        w_last = np.empty(width, np.int64)
         for x in range(width):
-            for step in range(n_w):
-                w = step if front_to_back else n_w - 1 - step
+            # (u, v) are linear in w: the slices inside, widened by one (the test is exact).
+            w_lo = 0.0
+            w_hi = n_w - 1.0
+            for a in range(2):
+                u0 = (inverse2[a, 0] * (x - shift[0]) + inverse2[a, 1] * (y - shift[1]))
+                slope = -(inverse2[a, 0] * shift[2] + inverse2[a, 1] * shift[3])
+                if slope == 0.0:
+                    if u0 < 0.0 or u0 > limits[a]:
+                        w_lo, w_hi = 1.0, 0.0
+                    continue
+                w0 = -u0 / slope
+                w1 = (limits[a] - u0) / slope
+                w_lo = max(w_lo, min(w0, w1))
+                w_hi = min(w_hi, max(w0, w1))
+            if w_lo > w_hi:
+                w_first[x], w_last[x] = 0, -1
+            else:
+                w_first[x] = max(0, int(math.floor(w_lo)) - 1)
+                w_last[x] = min(n_w - 1, int(math.ceil(w_hi)) + 1)
+        done = 0
+        for step in range(n_w):
+            w = step if front_to_back else n_w - 1 - step
+            end = 0.5 if w == 0 or w == n_w - 1 else 1.0
+            for x in range(width):
+                if not w_first[x] <= w <= w_last[x] or out[y, x, 3] >= threshold:
+                    continue
                 dx = x - shift[0] - w * shift[2]
                 dy = y - shift[1] - w * shift[3]
                 u = inverse2[0, 0] * dx + inverse2[0, 1] * dy
@@ -136,10 +288,7 @@ def composite_slices(vol, front_to_back, inverse2, shift, limits, tstart, tinv, 
                 if u < 0.0 or u > limits[0] or v < 0.0 or v > limits[1]:
                     continue
                 done += 1
-                end = 0.5 if w == 0 or w == n_w - 1 else 1.0
                 _over(vol[w, y, x], end, tstart, tinv, alpha_tab, color_tab, out, y, x)
-                if out[y, x, 3] >= threshold:
-                    break
         counts[y] = done
 
 
