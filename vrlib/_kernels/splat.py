@@ -42,28 +42,53 @@ SHEET, DIRECT = 0, 1
 RADIAL, PLANAR = 0, 1
 
 
-@jit
+@jit(inline="always")
+def radial_at(extent, radial, rho2):
+    """Radial footprint table (linear in rho^2) at squared distance ``rho2``."""
+    n = radial.shape[0]
+    x = rho2 / (extent * extent) * (n - 1)
+    if x >= n - 1:
+        return 0.0
+    i = int(x)
+    w = x - i
+    return radial[i] + w * (radial[i + 1] - radial[i])
+
+
+@jit(inline="always")
+def planar_row(extent_v, planar, v):
+    """Row of the planar footprint table at offset ``v``: its index ``j`` and fraction ``ty``
+    (``j = -1`` outside the table)."""
+    n = planar.shape[0]
+    y = (v + extent_v) * ((n - 1) / (2.0 * extent_v))
+    if not (y >= 0.0 and y <= n - 1):
+        return -1, 0.0
+    j = min(int(y), n - 2)
+    return j, y - j
+
+
+@jit(inline="always")
+def planar_at(extent, planar, j, ty, u):
+    """Planar footprint table, bilinear, at offset ``u`` on the row found by
+    :func:`planar_row`."""
+    n = planar.shape[0]
+    x = (u + extent) * ((n - 1) / (2.0 * extent))
+    if not (x >= 0.0 and x <= n - 1):
+        return 0.0
+    i = min(int(x), n - 2)
+    tx = x - i
+    return ((1.0 - ty) * ((1.0 - tx) * planar[j, i] + tx * planar[j, i + 1])
+            + ty * ((1.0 - tx) * planar[j + 1, i] + tx * planar[j + 1, i + 1]))
+
+
+@jit(inline="always")
 def footprint_at(kind, extent, extent_v, radial, planar, u, v):
     """Footprint at plane offsets (u, v): linear in rho^2 (radial) or bilinear (planar)."""
     if kind == RADIAL:
-        n = radial.shape[0]
-        x = (u * u + v * v) / (extent * extent) * (n - 1)
-        if x >= n - 1:
-            return 0.0
-        i = int(x)
-        w = x - i
-        return radial[i] + w * (radial[i + 1] - radial[i])
-    n = planar.shape[0]
-    x = (u + extent) * ((n - 1) / (2.0 * extent))
-    y = (v + extent_v) * ((n - 1) / (2.0 * extent_v))
-    if not (x >= 0.0 and y >= 0.0 and x <= n - 1 and y <= n - 1):
+        return radial_at(extent, radial, u * u + v * v)
+    j, ty = planar_row(extent_v, planar, v)
+    if j < 0:
         return 0.0
-    i = min(int(x), n - 2)
-    j = min(int(y), n - 2)
-    tx = x - i
-    ty = y - j
-    return ((1.0 - ty) * ((1.0 - tx) * planar[j, i] + tx * planar[j, i + 1])
-            + ty * ((1.0 - tx) * planar[j + 1, i] + tx * planar[j + 1, i + 1]))
+    return planar_at(extent, planar, j, ty, u)
 
 
 @jit
@@ -122,6 +147,22 @@ def row_extents(marks, axis, first, last):
             last[s, p] = hi
 
 
+@jit(inline="always")
+def _deposit(mode, f, fp, dens, er, eg, eb, threshold, sheet, touched, opaque, out, r, r0, c):
+    """One footprint pixel: into the sheet (``SHEET``), or composited at once (``DIRECT``)."""
+    if mode == SHEET:
+        sheet[r - r0, c] += f * fp
+        touched[r - r0, c] = True
+        return
+    alpha = -math.expm1(-dens * fp)
+    remaining = 1.0 - out[r, c, 3]
+    out[r, c, 0] += remaining * er * alpha
+    out[r, c, 1] += remaining * eg * alpha
+    out[r, c, 2] += remaining * eb * alpha
+    out[r, c, 3] += remaining * alpha
+    opaque[r - r0, c] = out[r, c, 3] >= threshold
+
+
 @parallel_jit
 def splat(data, origin, spacing, camera, height, width, axis, slices,
           fkind, extent, extent_v, radial, planar, mode, vstart, vinv, dens_tab, emit_tab,
@@ -156,6 +197,10 @@ def splat(data, origin, spacing, camera, height, width, axis, slices,
         r1 = min(r0 + band, height)
         sheet = np.zeros((r1 - r0, width))
         touched = np.zeros((r1 - r0, width), dtype=np.bool_)
+        opaque = np.zeros((r1 - r0, width), dtype=np.bool_)  # out[.., 3] >= threshold
+        for r in range(r0, r1):
+            for c in range(width):
+                opaque[r - r0, c] = out[r, c, 3] >= threshold
         drawn = 0
         counted = 0
         qx = spacing[0] if qa == 0 else 0.0
@@ -181,6 +226,7 @@ def splat(data, origin, spacing, camera, height, width, axis, slices,
                     else:
                         k = q
                     f = data[k, j, i]
+                    dens = 0.0
                     if cull and f == 0.0:
                         continue  # adds nothing to a sheet, and has no density to draw
                     if mode == DIRECT:
@@ -206,38 +252,50 @@ def splat(data, origin, spacing, camera, height, width, axis, slices,
                     if r0 <= row_c < r1 or (b == 0 and row_c < 0) or (
                             r1 == height and row_c >= height):
                         counted += 1
+                    er = eg = eb = 0.0
                     if mode == DIRECT:
                         er = interpolate_channel(emit_tab, vstart, vinv, f, 0)
                         eg = interpolate_channel(emit_tab, vstart, vinv, f, 1)
                         eb = interpolate_channel(emit_tab, vstart, vinv, f, 2)
                     for r in range(top, bottom + 1):
-                        for c in range(left, right + 1):
-                            if out[r, c, 3] >= threshold:
-                                continue
-                            if perspective:
+                        if perspective:
+                            for c in range(left, right + 1):
+                                if opaque[r - r0, c]:
+                                    continue
                                 o, d = pixel_ray(camera, height, width, r, c)
                                 wx, wy, wz = x - o[0], y - o[1], z - o[2]
                                 t = wx * d[0] + wy * d[1] + wz * d[2]
                                 # Ray point minus voxel, perpendicular to the ray.
                                 ox_, oy_, oz_ = t * d[0] - wx, t * d[1] - wy, t * d[2] - wz
                                 u, v = on_plane(camera, ox_, oy_, oz_)
-                            else:
+                                fp = footprint_at(fkind, extent, extent_v, radial, planar, u, v)
+                                if fp != 0.0:
+                                    drawn += 1
+                                    _deposit(mode, f, fp, dens, er, eg, eb, threshold, sheet,
+                                             touched, opaque, out, r, r0, c)
+                            continue
+                        # Orthographic: the row's offset v and its table row are shared.
+                        v = (row_c - r - 0.5) * px
+                        if fkind == RADIAL:
+                            vv = v * v
+                            for c in range(left, right + 1):
                                 u = (c + 0.5 - col_c) * px
-                                v = (row_c - r - 0.5) * px
-                            fp = footprint_at(fkind, extent, extent_v, radial, planar, u, v)
-                            if fp == 0.0:
+                                fp = radial_at(extent, radial, u * u + vv)
+                                if fp != 0.0 and not opaque[r - r0, c]:
+                                    drawn += 1
+                                    _deposit(mode, f, fp, dens, er, eg, eb, threshold, sheet,
+                                             touched, opaque, out, r, r0, c)
+                        else:
+                            row, ty = planar_row(extent_v, planar, v)
+                            if row < 0:
                                 continue
-                            drawn += 1
-                            if mode == SHEET:
-                                sheet[r - r0, c] += f * fp
-                                touched[r - r0, c] = True
-                            else:
-                                alpha = -math.expm1(-dens * fp)
-                                remaining = 1.0 - out[r, c, 3]
-                                out[r, c, 0] += remaining * er * alpha
-                                out[r, c, 1] += remaining * eg * alpha
-                                out[r, c, 2] += remaining * eb * alpha
-                                out[r, c, 3] += remaining * alpha
+                            for c in range(left, right + 1):
+                                u = (c + 0.5 - col_c) * px
+                                fp = planar_at(extent, planar, row, ty, u)
+                                if fp != 0.0 and not opaque[r - r0, c]:
+                                    drawn += 1
+                                    _deposit(mode, f, fp, dens, er, eg, eb, threshold, sheet,
+                                             touched, opaque, out, r, r0, c)
             if mode == SHEET:
                 # Classify the sheet as one segment per pixel and composite it (eqs 1.4, 1.7).
                 for r in range(r0, r1):
@@ -264,5 +322,6 @@ def splat(data, origin, spacing, camera, height, width, axis, slices,
                         out[r, c, 2] += weight * interpolate_channel(emit_tab, vstart, vinv,
                                                                              value, 2)
                         out[r, c, 3] += weight
+                        opaque[r - r0, c] = out[r, c, 3] >= threshold
         voxels[b] = counted
         pixels[b] = drawn
