@@ -1,15 +1,21 @@
 """This machine's ceilings and each renderer's fraction of them (``make bench``).
 
-The ceilings come from :func:`vrlib.roofline.measure`: STREAM-triad bandwidth, and the peak
-rate of trilinear and Catmull-Rom samples along rays inside a cache-resident brick. Every
-method then renders three scenes (dense Marschner-Lobb under Glow, a dense Gaussian blob, six
-sparse blobs under a thresholded ramp) at 256^3 -> 512^2, step 1; its rate is reconstructed
-points per second (:func:`vrlib.cost.points`). For ray casting, whose point is one 3-D
-reconstruction, the table gives the rate as a fraction of the sampling ceiling of its filter on
-the same number of threads. The other methods' points are other work (a footprint-table pixel
-for splatting, a composited sample after 1-D resampling passes for shearing), so the 3-D
-ceiling does not bound them and no fraction is given: their own ceilings are still to be
-measured. Sparse scenes skip most of the volume, so their rate counts only the points taken.
+The ceilings come from :func:`vrlib.roofline.measure`: STREAM-triad bandwidth, and the peak rate
+of each method's inner loop on cache-resident data: trilinear and Catmull-Rom samples along
+rays (ray casting), footprint-table pixels (splatting), 1-D resampled samples with per-output
+weights (the shear passes) and 2-D slice samples at one translation (shear-warp). Every method
+then renders three scenes (dense Marschner-Lobb under Glow, a dense Gaussian blob, six sparse
+blobs under a thresholded ramp) at 256^3 -> 512^2, step 1, and its rate is divided by the
+ceiling of its own inner loop and filter, on the same number of threads:
+
+* ray casting: reconstructed points (ray samples) per second / the 3-D sampling ceiling;
+* splatting: footprint pixels drawn per second / the footprint ceiling;
+* shear3, shear2: samples resampled by the passes per second / the 1-D resampling ceiling
+  (the compositing is extra work the ceiling does not include, so this fraction is the share
+  of the run time that the resampling alone would need at the ceiling);
+* shear-warp: composited 2-D samples per second / the slice ceiling.
+
+Sparse scenes skip most of the volume, so their rates count only the work taken.
 
 Prints Markdown tables and writes ``build/results/benchmarks/roofline.json``.
 """
@@ -45,23 +51,43 @@ def scenes():
     }
 
 
+#: The ceiling of each method's inner loop, per filter (module docstring).
+CEILINGS = {
+    "raycast": {"trilinear": "trilinear_float32", "catmull-rom": "tricubic_float32"},
+    "splat": {"trilinear": "footprint_trilinear", "catmull-rom": "footprint_catmull-rom"},
+    "shear3": {"trilinear": "resample_trilinear", "catmull-rom": "resample_catmull-rom"},
+    "shear2": {"trilinear": "resample_trilinear", "catmull-rom": "resample_catmull-rom"},
+    "shearwarp": {"trilinear": "slice_trilinear", "catmull-rom": "slice_catmull-rom"},
+}
+
+
+def inner_loop(method, filt, stats):
+    """The work a method's inner loop did (module docstring) and the name of its ceiling
+    (``None`` for a method without one)."""
+    limit = CEILINGS.get(method, {}).get(filt)
+    work = stats.voxels if method in ("shear3", "shear2") else points(stats)
+    return work, limit
+
+
 def main():
     threads = numba.config.NUMBA_NUM_THREADS
     limits = {t: roofline.measure(threads=t) for t in sorted({1, threads})}
-    rows = [[f"{t}", f"{lim['bandwidth'] / 1e9:.1f}", f"{lim['trilinear_float32'] / 1e6:.0f}",
-             f"{lim['trilinear_float64'] / 1e6:.0f}", f"{lim['tricubic_float32'] / 1e6:.0f}"]
-            for t, lim in limits.items()]
-    print("## This machine's ceilings\n")
-    print(markdown(["threads", "triad GB/s", "trilinear f32 M/s", "trilinear f64 M/s",
-                    "tricubic f32 M/s"], rows))
+    columns = {"trilinear_float32": "trilinear f32", "trilinear_float64": "trilinear f64",
+               "tricubic_float32": "tricubic f32", "footprint_trilinear": "footprint tent",
+               "footprint_catmull-rom": "footprint C-R", "resample_trilinear": "1-D resample 2 taps",
+               "resample_catmull-rom": "1-D resample C-R", "slice_trilinear": "slice 2x2",
+               "slice_catmull-rom": "slice 4x4"}
+    rows = [[f"{t}", f"{lim['bandwidth'] / 1e9:.1f}"]
+            + [f"{lim[key] / 1e6:.0f}" for key in columns] for t, lim in limits.items()]
+    print("## This machine's ceilings (M per second)\n")
+    print(markdown(["threads", "triad GB/s", *columns.values()], rows))
     ceiling = limits[threads]
     results = []
     for scene, (field, transfer) in scenes().items():
         volume = field.sample(N)
         view = vrlib.View.orbit(azimuth=30.0, elevation=20.0, size=SIZE)
         for method in vrlib.METHODS:
-            for filt, limit in (("trilinear", "trilinear_float32"),
-                                ("catmull-rom", "tricubic_float32")):
+            for filt in ("trilinear", "catmull-rom"):
                 try:
                     seconds, image = measure(partial(
                         vrlib.render, volume, view, method=method, filter=filt,
@@ -69,15 +95,19 @@ def main():
                 except ValueError:
                     continue
                 rate = points(image.stats) / seconds
-                fraction = rate / ceiling[limit] if method == "raycast" else None
+                work, limit = inner_loop(method, filt, image.stats)
+                fraction = work / seconds / ceiling[limit] if limit else None
                 results.append({"scene": scene, "method": method, "filter": filt,
                                 "seconds": seconds, "points": points(image.stats),
-                                "rate": rate, "fraction": fraction})
+                                "rate": rate, "work": work, "ceiling": limit,
+                                "fraction": fraction})
     print(f"\n## Renderers at {N}^3 -> {SIZE}^2, step {STEP:g}, {threads} threads: points "
-          "per second, and for ray casting the fraction of its sampling ceiling\n")
-    print(markdown(["scene", "method", "filter", "seconds", "M points/s", "of ceiling"],
+          "per second, and the inner loop's rate as a fraction of its ceiling\n")
+    print(markdown(["scene", "method", "filter", "seconds", "M points/s", "ceiling",
+                    "M inner/s", "of ceiling"],
                    [[r["scene"], r["method"], r["filter"], f"{r['seconds']:.3f}",
-                     f"{r['rate'] / 1e6:.1f}",
+                     f"{r['rate'] / 1e6:.1f}", r["ceiling"] or "-",
+                     f"{r['work'] / r['seconds'] / 1e6:.1f}",
                      "-" if r["fraction"] is None else f"{r['fraction']:.2f}"] for r in results]))
     write_record("roofline", {"machine": machine(), "n": N, "size": SIZE, "step": STEP,
                               "limits": {str(t): v for t, v in limits.items()},

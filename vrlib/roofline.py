@@ -9,7 +9,14 @@ ceiling (``make bench``, chapter 4):
 * ``trilinear``: trilinear samples per second along rays inside a brick that stays in cache,
   float32 and float64 samples (the ceiling of ray casting with the tent filter);
 * ``tricubic``: the same with a 4 x 4 x 4 Mitchell-Netravali cubic (Catmull-Rom): the
-  ceiling of every 4-tap filter (the cubics, the Gaussian).
+  ceiling of every 4-tap filter (the cubics, the Gaussian);
+* ``footprint``: footprint-table pixels per second drawn into a cache-resident sheet, for the
+  trilinear and Catmull-Rom footprints of a voxel :data:`PIXELS_PER_VOXEL` pixels wide (the
+  ceiling of splatting, whose point is one footprint pixel);
+* ``resample``: 1-D resampled samples per second along cache-resident lines with weights per
+  output, 2 taps (tent) and 4 (Catmull-Rom): the ceiling of a shear pass;
+* ``slice``: 2-D samples per second of a cache-resident slice at one translation (weights shared
+  by the slice), 2 x 2 and 4 x 4 taps: the ceiling of orthographic shear-warp.
 
 The sampling kernels (:mod:`vrlib._kernels.roofline`) do only the reconstruction, advanced
 incrementally along rays, with no bounds checks, classification or compositing: no renderer
@@ -24,14 +31,22 @@ import numpy as np
 from vrlib import validate
 from vrlib._kernels import roofline as _kernel
 from vrlib.cost import measure as _time
+from vrlib.footprint import footprint
+from vrlib.view import View
 
-__all__ = ["measure", "BRICK", "STEPS"]
+__all__ = ["measure", "BRICK", "STEPS", "PIXELS_PER_VOXEL", "SHEET", "LINE", "SLICE"]
 
 #: Samples per side of the cache-resident brick (32^3 float64 is 256 KiB: inside a core's
 #: L2 cache here, 512 KiB).
 BRICK = 32
 #: Samples per ray; the rays stay inside the brick.
 STEPS = 24
+#: Pixels across one voxel in the footprint measurement: a 256^3 volume drawn into a 512^2
+#: image framed by :meth:`vrlib.View.orbit`, as in the benchmarks.
+PIXELS_PER_VOXEL = 1.15
+#: Sheet side (pixels), line length and slice side (samples) of the other ceilings: each
+#: task's working set stays in its core's L2 cache.
+SHEET, LINE, SLICE = 64, 256, 64
 
 
 def _rays(count, direction, seed=0):
@@ -39,6 +54,37 @@ def _rays(count, direction, seed=0):
     travel = direction * (STEPS - 1)
     low, high = 1.0, BRICK - 3.0 - travel
     return np.random.default_rng(seed).uniform(low, high, (count, 3))
+
+
+def _other_ceilings(repeats, count, rng):
+    """The footprint, resampling and slice ceilings (module docstring); ``count`` sets the
+    work per run (footprints drawn, lines resampled)."""
+    out = {}
+    tasks = numba.get_num_threads()
+    px = 1.0 / PIXELS_PER_VOXEL
+    view_basis = View.orbit(azimuth=30.0, elevation=20.0).basis
+    for name in ("trilinear", "catmull-rom"):
+        fp = footprint(name, (1.0, 1.0, 1.0), view_basis)
+        reach = max(fp.extent, fp.extent_v) / px
+        centres = rng.uniform(reach + 1.0, SHEET - reach - 2.0, (count, 2))
+        sheets = np.zeros((tasks, SHEET, SHEET))
+        seconds, drawn = _time(lambda fp=fp, centres=centres, sheets=sheets:
+                               _kernel.draw_footprints(fp.table, fp.extent, fp.extent_v, px, centres,
+                                                       sheets), repeats=repeats)
+        out[f"footprint_{name}"] = drawn / seconds
+    lines = rng.uniform(0.0, 1.0, (16, LINE)).astype(np.float32)
+    resampled = np.empty((max(tasks, count // 16), LINE - 8), np.float32)
+    slices = rng.uniform(0.0, 1.0, (4, SLICE + 4, SLICE + 4))
+    planes = np.empty((max(tasks, count // 256), SLICE, SLICE))
+    for name, ntaps in (("trilinear", 2), ("catmull-rom", 4)):
+        seconds, _ = _time(lambda ntaps=ntaps: _kernel.resample_lines(
+            lines, 1.004, 2.0, ntaps, 0.0, 0.5, resampled), repeats=repeats)
+        out[f"resample_{name}"] = resampled.size / seconds
+        weights = np.full(ntaps, 1.0 / ntaps)
+        seconds, _ = _time(lambda ntaps=ntaps, weights=weights: _kernel.resample_slices(
+            slices, ntaps, weights, weights, planes), repeats=repeats)
+        out[f"slice_{name}"] = planes.size / seconds
+    return out
 
 
 def measure(*, threads=None, repeats=5, elements=1 << 24, rays=1 << 16):
@@ -59,14 +105,18 @@ def measure(*, threads=None, repeats=5, elements=1 << 24, rays=1 << 16):
     -------
     dict
         ``bandwidth`` (bytes/s), ``trilinear_float32``, ``trilinear_float64``,
-        ``tricubic_float32`` and ``tricubic_float64`` (samples/s), and ``threads``.
+        ``tricubic_float32`` and ``tricubic_float64`` (samples/s), ``footprint_trilinear``
+        and ``footprint_catmull-rom`` (pixels/s), ``resample_trilinear``,
+        ``resample_catmull-rom``, ``slice_trilinear`` and ``slice_catmull-rom`` (samples/s;
+        named by the filter whose 1-D kernel they use), and ``threads``.
 
     Examples
     --------
     >>> limits = measure(repeats=1, elements=1 << 16, rays=1 << 10)
     >>> sorted(limits)   # doctest: +NORMALIZE_WHITESPACE
-    ['bandwidth', 'threads', 'tricubic_float32', 'tricubic_float64', 'trilinear_float32',
-     'trilinear_float64']
+    ['bandwidth', 'footprint_catmull-rom', 'footprint_trilinear', 'resample_catmull-rom',
+     'resample_trilinear', 'slice_catmull-rom', 'slice_trilinear', 'threads',
+     'tricubic_float32', 'tricubic_float64', 'trilinear_float32', 'trilinear_float64']
     >>> bool(limits["trilinear_float32"] > limits["tricubic_float32"] > 0)
     True
     """
@@ -91,6 +141,7 @@ def measure(*, threads=None, repeats=5, elements=1 << 24, rays=1 << 16):
                 seconds, _ = _time(lambda brick=brick, cubic=cubic: _kernel.sample_rays(
                     brick, starts, direction, STEPS, cubic, 0.0, 0.5, sums), repeats=repeats)
                 out[f"{name}_{np.dtype(dtype).name}"] = samples / seconds
+        out.update(_other_ceilings(repeats, rays, rng))
         out["threads"] = numba.get_num_threads()
         return out
     finally:

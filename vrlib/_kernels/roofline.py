@@ -1,5 +1,7 @@
-"""Micro-kernels that measure what this machine allows: memory bandwidth and the peak rate of
-trilinear and tricubic samples from a brick that stays in cache.
+"""Micro-kernels that measure what this machine allows: memory bandwidth, the peak rate of
+trilinear and tricubic samples from a brick that stays in cache, and the peak rates of the other
+methods' inner loops: footprint pixels (splatting), 1-D resampled samples (the shear passes)
+and 2-D resampled slice samples (shear-warp).
 
 Each kernel does the work of a renderer's inner loop and nothing else: no classification, no
 bounds checks (positions are kept inside the brick by construction), rays advanced
@@ -9,10 +11,14 @@ incrementally. They set the ceilings the renderers are measured against
 
 from __future__ import annotations
 
+import math
+
+import numpy as np
 from numba import prange
 
 from vrlib._kernels._jit import parallel_jit
 from vrlib._kernels.sampling import cubic_weights, lerp_corners
+from vrlib._kernels.splat import planar_at, planar_row
 
 
 @parallel_jit
@@ -61,3 +67,79 @@ def sample_rays(brick, starts, direction, steps, cubic, b, c, out):
             uy += dy
             uz += dz
         out[r] = acc
+
+
+@parallel_jit
+def draw_footprints(planar, extent, extent_v, px, centres, sheets):
+    """Splatting's inner loop alone: footprint ``planar`` (a planar table reaching ``extent``
+    and ``extent_v`` world units along the image's right and up, pixels ``px`` wide) drawn at each ``centres[n] = (row, col)`` into one
+    cache-resident sheet per task (``sheets[t]``), over the pixels the table reaches, with
+    unit voxel values. Orthographic: each row's table row is found once. Returns the pixels drawn."""
+    tasks = sheets.shape[0]
+    reach_u = extent / px
+    reach_v = extent_v / px
+    per_task = centres.shape[0] // tasks
+    drawn = 0
+    for task in prange(tasks):
+        sheet = sheets[task]
+        count = 0
+        for n in range(task * per_task, (task + 1) * per_task):
+            row_c = centres[n, 0]
+            col_c = centres[n, 1]
+            top = int(math.ceil(row_c - reach_v - 0.5))
+            bottom = int(math.floor(row_c + reach_v - 0.5))
+            left = int(math.ceil(col_c - reach_u - 0.5))
+            right = int(math.floor(col_c + reach_u - 0.5))
+            for r in range(top, bottom + 1):
+                row, ty = planar_row(extent_v, planar, (row_c - r - 0.5) * px)
+                if row < 0:
+                    continue
+                for c in range(left, right + 1):
+                    sheet[r, c] += planar_at(extent, planar, row, ty, (c + 0.5 - col_c) * px)
+                count += right - left + 1
+        drawn += count
+    return drawn
+
+
+@parallel_jit
+def resample_lines(lines, scale, shift, ntaps, b, c, out):
+    """A shear pass's inner loop alone: output line ``out[n]`` is line ``lines[n % len(lines)]``
+    (a few lines, so they stay in cache) resampled at ``q / scale + shift`` for each output
+    ``q``, with per-output weights: the tent (``ntaps = 2``) or the Mitchell-Netravali (B, C)
+    cubic (``ntaps = 4``), no clamping (the positions stay inside the line)."""
+    for n in prange(out.shape[0]):
+        src = n % lines.shape[0]
+        w = np.empty(4)
+        for q in range(out.shape[1]):
+            pos = q / scale + shift
+            first = int(math.floor(pos))
+            t = pos - first
+            if ntaps == 2:
+                w[0] = 1.0 - t
+                w[1] = t
+            else:
+                w[0], w[1], w[2], w[3] = cubic_weights(t, b, c)
+                first -= 1
+            acc = 0.0
+            for a in range(ntaps):
+                acc += w[a] * lines[src, first + a]
+            out[n, q] = acc
+
+
+@parallel_jit
+def resample_slices(slices, ntaps, wi, wj, out):
+    """Shear-warp's inner loop alone (orthographic): ``out[k]`` takes slice
+    ``slices[k % len(slices)]`` (a few slices, so they stay in cache) resampled at a
+    translation, the same ``ntaps x ntaps`` weights (``wi`` along rows, ``wj`` across) for every
+    pixel."""
+    for k in prange(out.shape[0]):
+        src = k % slices.shape[0]
+        for j in range(out.shape[1]):
+            for i in range(out.shape[2]):
+                value = 0.0
+                for bj in range(ntaps):
+                    line = 0.0
+                    for ai in range(ntaps):
+                        line += wi[ai] * slices[src, j + bj, i + ai]
+                    value += wj[bj] * line
+                out[k, j, i] = value
