@@ -185,9 +185,57 @@ def test_a_ramp_of_ones_changes_nothing():
         assert np.array_equal(base.rgba, same.rgba)
 
 
-@pytest.mark.parametrize("method", ["splat", "shear3", "shear2", "shearwarp"])
-def test_methods_without_gradients_refuse_gradient_opacity(method):
+@pytest.mark.parametrize("method, options", [("splat", {}), ("splat", {"mode": "sheet"}),
+                                             ("shear3", {}), ("shear2", {}),
+                                             ("shearwarp", {})])
+def test_methods_without_gradients_refuse_gradient_opacity(method, options):
+    """Sheet splatting, the shear passes and post-classified shear-warp reconstruct values
+    only; each refuses gradients and names what takes them."""
     volume = data_gen.make_field("gaussian-blob", sigma=0.3).sample(8)
     transfer = vrlib.Glow(1.0, gradient_opacity=vrlib.GradientOpacity([0, 1], [0, 1]))
-    with pytest.raises(ValueError, match="gradient_opacity"):
-        vrlib.render(volume, vrlib.View.orbit(size=8), method=method, transfer=transfer)
+    with pytest.raises(ValueError, match="gradient_opacity.*raycast"):
+        vrlib.render(volume, vrlib.View.orbit(size=8), method=method, transfer=transfer,
+                     **options)
+    with pytest.raises(ValueError, match="does not shade"):
+        vrlib.render(volume, vrlib.View.orbit(size=8), method=method, **options,
+                     transfer=vrlib.Glow(1.0, shading=vrlib.Phong()))
+
+
+@pytest.mark.parametrize("projection", ["orthographic", "perspective"])
+@pytest.mark.parametrize("filt", ["trilinear", "catmull-rom", "gaussian"])
+def test_direct_splatting_classifies_and_shades_each_voxel(projection, filt):
+    """Direct splatting with gradients follows the naive twin (each voxel classified by its own
+    central-difference gradient and shaded as seen from the eye); the per-voxel values are
+    float32, hence the 1e-6 bound."""
+    from naive import splat_naive
+
+    volume = data_gen.make_field("random-blobs", count=4, seed=2).sample((5, 6, 7))
+    view = vrlib.View.orbit(azimuth=33, elevation=-21, size=(7, 9), projection=projection)
+    transfer = vrlib.LookupTransfer(
+        [0.0, 3.0, 1.0, 5.0], [[1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 1]],
+        shading=vrlib.Phong(specular=0.4, light=[0.0, 0.6, 0.8]),
+        gradient_opacity=vrlib.GradientOpacity([0.0, 2.0], [0.2, 1.0]))
+    fast = vrlib.render(volume, view, method="splat", mode="direct", filter=filt,
+                        transfer=transfer, early_termination=1.0)
+    slow = splat_naive(volume, view, vrlib.make_filter(filt), transfer, "direct")
+    np.testing.assert_allclose(fast.rgba, slow, atol=1e-6)
+    assert fast.alpha.max() > 0.05
+
+
+@pytest.mark.parametrize("filt", ["trilinear", "catmull-rom"])
+def test_direct_splatting_shaded_converges_to_the_reference(filt):
+    """Pre-shaded splats (each voxel classified and shaded by its central-difference gradient,
+    then reconstructed) against the reference renderer (the exact field's gradient) on a smooth
+    blob: shading and gradient opacity come out right. Measured at 64^3: rmse 3.5e-4
+    (trilinear) and 2.0e-4 (Catmull-Rom), against 0.10 for the same image unshaded."""
+    field = data_gen.make_field("gaussian-blob", sigma=0.35)
+    view = vrlib.View.orbit(azimuth=30, elevation=20, size=64)
+    transfer = vrlib.Glow(3.0, shading=vrlib.Phong(specular=0.3, light=[0.0, 0.6, 0.8]),
+                          gradient_opacity=vrlib.GradientOpacity([0.0, 2.0], [0.3, 1.0]))
+    reference = vrlib.render_reference(field, view, transfer=transfer, tol=1e-5)
+    splat = vrlib.render(field.sample(64), view, method="splat", mode="direct", filter=filt,
+                         transfer=transfer)
+    unshaded = vrlib.render(field.sample(64), view, method="splat", mode="direct",
+                            filter=filt, transfer=vrlib.Glow(3.0))
+    assert vrlib.metrics.rmse(splat, reference) < 1e-3
+    assert vrlib.metrics.rmse(unshaded, reference) > 0.05

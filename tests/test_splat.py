@@ -253,7 +253,8 @@ def test_principal_axis_and_order():
         ({"filter": ("gaussian", -0.5, 2.0)}, ValueError, "sigma must be > 0"),
         ({"filter": ("gaussian", 0.5, 0.0)}, ValueError, "radius must be > 0"),
         ({"filter": ("gaussian", 0.5, 6.0)}, ValueError, "radius 6 is out of range"),
-        ({"transfer": Glow(1.0, shading=Phong())}, ValueError, "splatting does not shade"),
+        ({"transfer": Glow(1.0, shading=Phong())}, ValueError,
+         "splatting with sheet buffers does not shade .* mode='direct'"),
         ({"table": 3}, TypeError, "method 'splat' takes no option 'table'; its options: mode"),
     ],
 )

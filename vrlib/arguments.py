@@ -65,12 +65,13 @@ def render_arguments(view, filter, transfer, step, early_termination=1.0):
     return filt, transfer, step, early_termination
 
 
-def refuse_gradients(transfer, who):
+def refuse_gradients(transfer, who, instead="method='raycast', method='splat' with "
+                     "mode='direct', or vrlib.classify for shear-warp"):
     """Refuse a transfer function that needs gradients (shading, gradient opacity) where
-    ``who`` (a renderer) reconstructs values only."""
+    ``who`` (a renderer) reconstructs values only; ``instead`` names what takes them."""
     if transfer.shading is not None:
-        raise ValueError(f"{who} does not shade (it reconstructs no gradients); use "
-                         f"method='raycast' (or vrlib.classify for shear-warp) for shaded images")
+        raise ValueError(f"{who} does not shade (it reconstructs no gradients); for shaded "
+                         f"images use {instead}")
     if transfer.gradient_opacity is not None:
         raise ValueError(f"{who} reconstructs no gradients, so it cannot classify by gradient "
-                         f"magnitude (gradient_opacity); use method='raycast' or vrlib.classify")
+                         f"magnitude (gradient_opacity); use {instead}")

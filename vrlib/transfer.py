@@ -53,27 +53,45 @@ class Phong:
         self.shininess = validate.positive_number("shininess", shininess)
         self.light = None if light is None else validate.vector3("light", light, unit=True)
 
-    def factor(self, gradient, view_dir):
-        """Multiplier of the emission for gradients ``(..., 3)`` seen from ``view_dir``."""
-        v = validate.vector3("view_dir", view_dir, unit=True)
-        light = v if self.light is None else self.light
+    def _directions(self, view_dir):
+        """Unit directions towards the eye and the light: one for every point, or per point
+        (``view_dir`` of shape ``(..., 3)``, each normalised; perspective views)."""
+        v = np.asarray(view_dir, dtype=np.float64)
+        if v.shape == (3,):
+            v = validate.vector3("view_dir", view_dir, unit=True)
+        else:
+            if v.ndim < 1 or v.shape[-1] != 3 or not np.all(np.isfinite(v)):
+                raise ValueError("view_dir must be 3 finite floats or an array (..., 3) of "
+                                 f"them, got shape {v.shape}")
+            norm = np.linalg.norm(v, axis=-1, keepdims=True)
+            if not np.all(norm > 0.0):
+                raise ValueError("view_dir must not contain zero vectors")
+            v = v / norm
+        return v, v if self.light is None else self.light
+
+    @staticmethod
+    def _normals(gradient):
+        """Unit normals ``-g / |g|`` and whether each gradient has one."""
         g = np.asarray(gradient, dtype=np.float64)
         norm = np.linalg.norm(g, axis=-1)
-        safe = np.where(norm > 0.0, norm, 1.0)[..., None]
-        n = -g / safe
-        ndotl = np.where(norm > 0.0, np.abs(n @ light), 1.0)
+        return -g / np.where(norm > 0.0, norm, 1.0)[..., None], norm > 0.0
+
+    def factor(self, gradient, view_dir):
+        """Multiplier of the emission for gradients ``(..., 3)`` seen from ``view_dir`` (one
+        unit vector towards the eye, or one per gradient)."""
+        _, light = self._directions(view_dir)
+        n, has = self._normals(gradient)
+        ndotl = np.where(has, np.abs(np.sum(n * light, axis=-1)), 1.0)
         return self.ambient + self.diffuse * ndotl
 
     def highlight(self, gradient, view_dir):
         """Specular term (added to every colour channel) for gradients ``(..., 3)``."""
-        v = validate.vector3("view_dir", view_dir, unit=True)
-        light = v if self.light is None else self.light
+        v, light = self._directions(view_dir)
         half = light + v
-        half = half / np.linalg.norm(half) if np.any(half) else light
-        g = np.asarray(gradient, dtype=np.float64)
-        norm = np.linalg.norm(g, axis=-1)
-        n = -g / np.where(norm > 0.0, norm, 1.0)[..., None]
-        ndoth = np.where(norm > 0.0, np.abs(n @ half), 1.0)
+        length = np.linalg.norm(half, axis=-1, keepdims=True)
+        half = np.where(length > 0.0, half / np.where(length > 0.0, length, 1.0), light)
+        n, has = self._normals(gradient)
+        ndoth = np.where(has, np.abs(np.sum(n * half, axis=-1)), 1.0)
         return self.specular * ndoth**self.shininess
 
     def __repr__(self):

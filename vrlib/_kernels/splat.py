@@ -166,13 +166,16 @@ def _deposit(mode, f, fp, dens, er, eg, eb, threshold, sheet, touched, opaque, o
 @parallel_jit
 def splat(data, origin, spacing, camera, height, width, axis, slices,
           fkind, extent, extent_v, radial, planar, mode, vstart, vinv, dens_tab, emit_tab,
-          threshold, cull, row_first, row_last, reach_max, band, order, out, voxels, pixels):
+          per_voxel, voxel_density, voxel_colour, threshold, cull, row_first, row_last,
+          reach_max, band, order, out, voxels, pixels):
     """Splat ``data[z, y, x]`` into ``out`` (premultiplied RGBA), bands of ``band`` rows.
 
     ``axis`` (0, 1, 2 for x, y, z) is the slicing axis and ``slices`` its indices front to
     back. Footprints are ``fkind`` tables (:mod:`vrlib.footprint`) reaching ``extent`` (along
     the image's right) and ``extent_v`` (up) world units. Classification reads density and
-    emission tables over values (``vstart``, ``vinv``). With ``cull``, voxels of value zero are
+    emission tables over values (``vstart``, ``vinv``), or in direct mode with ``per_voxel``
+    each voxel's own ``voxel_density`` and ``voxel_colour`` (classified and shaded from its
+    gradient beforehand). With ``cull``, voxels of value zero are
     never drawn (they add nothing to a sheet) and in direct mode neither are voxels of zero
     density. Pixels whose opacity has reached ``threshold`` take no more (1 turns that off).
     ``row_first[s, p]`` and ``row_last[s, p]`` bound the voxels of each row of each slice that
@@ -230,7 +233,10 @@ def splat(data, origin, spacing, camera, height, width, axis, slices,
                     if cull and f == 0.0:
                         continue  # adds nothing to a sheet, and has no density to draw
                     if mode == DIRECT:
-                        dens = interpolate(dens_tab, vstart, vinv, f)
+                        if per_voxel:
+                            dens = voxel_density[k, j, i]
+                        else:
+                            dens = interpolate(dens_tab, vstart, vinv, f)
                         if cull and not dens > 0.0:
                             continue
                     x = origin[0] + i * spacing[0]
@@ -253,7 +259,11 @@ def splat(data, origin, spacing, camera, height, width, axis, slices,
                             r1 == height and row_c >= height):
                         counted += 1
                     er = eg = eb = 0.0
-                    if mode == DIRECT:
+                    if mode == DIRECT and per_voxel:
+                        er = voxel_colour[k, j, i, 0]
+                        eg = voxel_colour[k, j, i, 1]
+                        eb = voxel_colour[k, j, i, 2]
+                    elif mode == DIRECT:
                         er = interpolate_channel(emit_tab, vstart, vinv, f, 0)
                         eg = interpolate_channel(emit_tab, vstart, vinv, f, 1)
                         eb = interpolate_channel(emit_tab, vstart, vinv, f, 2)
