@@ -15,7 +15,10 @@ ceiling of its own inner loop and filter, on the same number of threads:
   of the run time that the resampling alone would need at the ceiling);
 * shear-warp: composited 2-D samples per second / the slice ceiling.
 
-Sparse scenes skip most of the volume, so their rates count only the work taken.
+Sparse scenes skip most of the volume, so their rates count only the work taken. A last table
+follows the ray caster from its ceiling to a render (:func:`vrlib.roofline.ray_caster_ladder`):
+the renderer's own sampling, then its classification and compositing, on a brick in cache, then
+the renders themselves.
 
 Prints Markdown tables and writes ``build/results/benchmarks/roofline.json``.
 """
@@ -109,9 +112,18 @@ def main():
                      f"{r['rate'] / 1e6:.1f}", r["ceiling"] or "-",
                      f"{r['work'] / r['seconds'] / 1e6:.1f}",
                      "-" if r["fraction"] is None else f"{r['fraction']:.2f}"] for r in results]))
+    ladder = roofline.ray_caster_ladder(threads=threads)
+    for r in results:
+        if r["method"] == "raycast" and r["filter"] == "trilinear":
+            ladder[f"render: {r['scene']}"] = r["rate"]
+    top = ladder["ceiling"]
+    print(f"\n## Where the ray caster's time goes (trilinear, float64, {threads} threads)\n")
+    print(markdown(["step", "M samples/s", "of ceiling"],
+                   [[name, f"{rate / 1e6:.0f}", f"{rate / top:.2f}"]
+                    for name, rate in ladder.items()]))
     write_record("roofline", {"machine": machine(), "n": N, "size": SIZE, "step": STEP,
                               "limits": {str(t): v for t, v in limits.items()},
-                              "renderers": results})
+                              "renderers": results, "ray_caster_ladder": ladder})
 
 
 if __name__ == "__main__":

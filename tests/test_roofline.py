@@ -105,3 +105,26 @@ def test_resampled_lines_and_slices_match_the_filter(filt, ntaps):
         expected = sum(wj[b] * wi[a] * s[b:b + 8, a:a + 8] for b in range(ntaps)
                        for a in range(ntaps))
         np.testing.assert_allclose(planes[n], expected, rtol=1e-12)
+
+
+def test_ray_caster_ladder_kernels_do_the_renderers_work():
+    """The ladder's kernel samples the same points as the ceiling's (to rounding: positions from
+    the lattice, not incremental), and with classification composites the table's opacities
+    front to back."""
+    brick, starts, direction = rays_and_brick(np.float64)
+    ceiling, plain, composited = (np.empty(len(starts)) for _ in range(3))
+    table = np.linspace(0.0, 0.2, 11)
+    kernels.sample_rays(brick, starts, direction, roofline.STEPS, False, 0.0, 0.5, ceiling)
+    kernels.march_rays(brick, starts, direction, roofline.STEPS, False, -1.0, 5.0, table, plain)
+    kernels.march_rays(brick, starts, direction, roofline.STEPS, True, -1.0, 5.0, table,
+                       composited)
+    np.testing.assert_allclose(plain, ceiling, rtol=1e-12)
+    points = points_along(starts, direction)
+    values = reconstruct_naive(Volume(brick), make_filter("trilinear"),
+                               points.reshape(-1, 3)).reshape(points.shape[:2])
+    alpha = np.interp((values + 1.0) * 5.0, np.arange(11), table)
+    expected = 1.0 - np.prod(1.0 - alpha, axis=1)
+    np.testing.assert_allclose(composited, expected, rtol=1e-12)
+    ladder = roofline.ray_caster_ladder(threads=1, repeats=1, rays=64)
+    assert list(ladder) == ["ceiling", "renderer sampling", "with classification and compositing"]
+    assert all(rate > 0 for rate in ladder.values())

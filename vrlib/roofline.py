@@ -34,7 +34,7 @@ from vrlib.cost import measure as _time
 from vrlib.footprint import footprint
 from vrlib.view import View
 
-__all__ = ["measure", "BRICK", "STEPS", "PIXELS_PER_VOXEL", "SHEET", "LINE", "SLICE"]
+__all__ = ["measure", "ray_caster_ladder", "BRICK", "STEPS", "PIXELS_PER_VOXEL", "SHEET", "LINE", "SLICE"]
 
 #: Samples per side of the cache-resident brick (32^3 float64 is 256 KiB: inside a core's
 #: L2 cache here, 512 KiB).
@@ -144,5 +144,43 @@ def measure(*, threads=None, repeats=5, elements=1 << 24, rays=1 << 16):
         out.update(_other_ceilings(repeats, rays, rng))
         out["threads"] = numba.get_num_threads()
         return out
+    finally:
+        numba.set_num_threads(previous)
+
+
+def ray_caster_ladder(*, threads=None, repeats=5, rays=1 << 16):
+    """Where the ray caster's time goes between the trilinear ceiling and a render: the rate
+    (samples/s, float64 brick in cache) of the ceiling's kernel, of the renderer's own sampling
+    (positions from the global lattice, floor and bounds check), and of that sampling with the
+    renderer's classification and compositing. A render's rate below the last step is lost to
+    what the brick leaves out: a volume larger than the caches, ray set-up, skipping.
+
+    Examples
+    --------
+    >>> ladder = ray_caster_ladder(repeats=1, rays=1 << 10)
+    >>> list(ladder)
+    ['ceiling', 'renderer sampling', 'with classification and compositing']
+    """
+    repeats = validate.positive_int("repeats", repeats)
+    rays = validate.positive_int("rays", rays)
+    previous = numba.get_num_threads()
+    if threads is not None:
+        numba.set_num_threads(validate.positive_int("threads", threads))
+    try:
+        direction = np.array([0.36, 0.48, 0.8])
+        starts = _rays(rays, direction)
+        brick = np.random.default_rng(1).uniform(0.0, 1.0, (BRICK,) * 3)
+        table = np.linspace(0.0, 0.01, 256)  # a segment-opacity table over the values [0, 1]
+        sums = np.empty(rays)
+        samples = rays * STEPS
+        runs = {
+            "ceiling": lambda: _kernel.sample_rays(brick, starts, direction, STEPS, False, 0.0,
+                                                   0.5, sums),
+            "renderer sampling": lambda: _kernel.march_rays(brick, starts, direction, STEPS,
+                                                            False, 0.0, 255.0, table, sums),
+            "with classification and compositing": lambda: _kernel.march_rays(
+                brick, starts, direction, STEPS, True, 0.0, 255.0, table, sums),
+        }
+        return {name: samples / _time(run, repeats=repeats)[0] for name, run in runs.items()}
     finally:
         numba.set_num_threads(previous)

@@ -17,8 +17,9 @@ import numpy as np
 from numba import prange
 
 from vrlib._kernels._jit import parallel_jit
-from vrlib._kernels.sampling import cubic_weights, lerp_corners
+from vrlib._kernels.sampling import cubic_weights, lerp_corners, trilinear
 from vrlib._kernels.splat import planar_at, planar_row
+from vrlib._kernels.tables import lookup
 
 
 @parallel_jit
@@ -143,3 +144,30 @@ def resample_slices(slices, ntaps, wi, wj, out):
                         line += wi[ai] * slices[src, j + bj, i + ai]
                     value += wj[bj] * line
                 out[k, j, i] = value
+
+
+@parallel_jit
+def march_rays(brick, starts, direction, steps, classify, tstart, tinv, alpha_tab, out):
+    """The ray caster's own per-sample work on a cache-resident brick, for the ladder from the
+    sampling ceiling to the renderer: positions from the sample's parameter (the global
+    lattice), the renderer's :func:`~vrlib._kernels.sampling.trilinear` (floor, bounds check);
+    with ``classify``, each sample's segment opacity from the table and front-to-back
+    compositing (``out`` is the ray's opacity), else the plain sum of the samples."""
+    flat = brick.reshape(-1)
+    nz, ny, nx = brick.shape
+    nxy = ny * nx
+    ntab = alpha_tab.shape[0]
+    for r in prange(starts.shape[0]):
+        ax, ay, az = starts[r, 0], starts[r, 1], starts[r, 2]
+        acc = 0.0
+        for k in range(steps):
+            t = float(k)
+            value = trilinear(flat, nx, nxy, 0, 0, 0, nz, ny, nx, ax + t * direction[0],
+                              ay + t * direction[1], az + t * direction[2])
+            if classify:
+                i, w = lookup((value - tstart) * tinv, ntab)
+                alpha = alpha_tab[i] + w * (alpha_tab[i + 1] - alpha_tab[i])
+                acc += (1.0 - acc) * alpha
+            else:
+                acc += value
+        out[r] = acc
