@@ -77,7 +77,8 @@ def main():
     limits = {t: roofline.measure(threads=t) for t in sorted({1, threads})}
     columns = {"trilinear_float32": "trilinear f32", "trilinear_float64": "trilinear f64",
                "tricubic_float32": "tricubic f32", "footprint_trilinear": "footprint tent",
-               "footprint_catmull-rom": "footprint C-R", "resample_trilinear": "1-D resample 2 taps",
+               "footprint_catmull-rom": "footprint C-R",
+               "resample_trilinear": "1-D resample 2 taps",
                "resample_catmull-rom": "1-D resample C-R", "slice_trilinear": "slice 2x2",
                "slice_catmull-rom": "slice 4x4"}
     rows = [[f"{t}", f"{lim['bandwidth'] / 1e9:.1f}"]

@@ -219,30 +219,44 @@ def shear_naive(volume, view, filt, transfer, step, passes):
     ds = step * float(volume.spacing.min())
     plan = plan_shear(volume, view, ds)
     u, v, w = plan.order
-    data = np.transpose(np.asarray(volume.data, float), (2 - w, 2 - v, 2 - u))
-    nw, nv, nu = data.shape
     h, wd = view.shape
-    v1, ok1 = shear_pass_naive(data, np.ones(data.shape, bool), (nw, nv, wd), plan.a, plan.b,
-                               plan.c, plan.t0, filt)
-    v2, ok2 = shear_pass_naive(v1.transpose(0, 2, 1), ok1.transpose(0, 2, 1), (nw, wd, h),
-                               plan.e, plan.d, plan.f, plan.t1, filt)
-    v2, ok2 = v2.transpose(0, 2, 1), ok2.transpose(0, 2, 1)
-    image = np.zeros(view.shape + (4,))
-    limits = np.array([nu, nv, nw]) - 1.0
-    if passes == 3:
+    field = np.asarray(volume.data, float)
+    channels = [field]
+    if transfer.needs_gradient:  # the samples' central differences, world units, x y z
+        hx, hy, hz = volume.spacing
+        channels += [np.gradient(field, hx, axis=2), np.gradient(field, hy, axis=1),
+                     np.gradient(field, hz, axis=0)]
+
+    def resampled(channel):
+        data = np.transpose(channel, (2 - w, 2 - v, 2 - u))
+        nw, nv, nu = data.shape
+        v1, ok1 = shear_pass_naive(data, np.ones(data.shape, bool), (nw, nv, wd), plan.a,
+                                   plan.b, plan.c, plan.t0, filt)
+        v2, ok2 = shear_pass_naive(v1.transpose(0, 2, 1), ok1.transpose(0, 2, 1), (nw, wd, h),
+                                   plan.e, plan.d, plan.f, plan.t1, filt)
+        v2, ok2 = v2.transpose(0, 2, 1), ok2.transpose(0, 2, 1)
+        if passes == 2:
+            return v2
         v3, _ = shear_pass_naive(v2.transpose(1, 2, 0), ok2.transpose(1, 2, 0),
                                  (h, wd, plan.depth_samples), plan.i, plan.g, plan.h, plan.t2,
                                  filt)
-        v3 = v3.transpose(2, 0, 1)
+        return v3.transpose(2, 0, 1)
+
+    volumes = [resampled(channel) for channel in channels]
+    nw, nv, nu = np.transpose(field, (2 - w, 2 - v, 2 - u)).shape
+    image = np.zeros(view.shape + (4,))
+    limits = np.array([nu, nv, nw]) - 1.0
+    if passes == 3:
         inverse = np.linalg.inv(plan.matrix)
-        samples = [(z, v3[z]) for z in range(v3.shape[0])]
+        order = range(volumes[0].shape[0])
         length = ds
     else:
         order = range(nw) if plan.i > 0 else range(nw - 1, -1, -1)
-        samples = [(z, v2[z]) for z in order]
         length = abs(plan.i) * ds  # half that for the end slices (below)
+    samples = [(z, volumes[0][z], np.stack([g[z] for g in volumes[1:]], -1)
+                if len(volumes) > 1 else None) for z in order]
     rows, cols = np.mgrid[0:h, 0:wd]
-    for z, layer in samples:
+    for z, layer, grad in samples:
         if passes == 3:
             pts = np.stack([cols - plan.shift[0], rows - plan.shift[1],
                             np.full(rows.shape, z - plan.shift[2])], -1) @ inverse.T
@@ -254,10 +268,18 @@ def shear_naive(volume, view, filt, transfer, step, passes):
             uv = rhs @ np.linalg.inv(m[:2, :2]).T
             inside = np.all((uv >= 0) & (uv <= limits[:2]), axis=-1)
         end = passes == 2 and z in (0, nw - 1)  # end slices reach half a spacing in
-        alpha = -np.expm1(-transfer.opacity_density(layer) * length * (0.5 if end else 1.0))
+        density = transfer.opacity_density(layer)
+        colour = transfer.emission(layer)
+        if grad is not None:
+            if transfer.gradient_opacity is not None:
+                density = density * transfer.gradient_opacity.factor(
+                    np.linalg.norm(grad, axis=-1))
+            if transfer.shading is not None:
+                colour = (colour * transfer.shading.factor(grad, -view.forward)[..., None]
+                          + transfer.shading.highlight(grad, -view.forward)[..., None])
+        alpha = -np.expm1(-density * length * (0.5 if end else 1.0))
         alpha = alpha * inside
-        segment = np.concatenate([transfer.emission(layer) * alpha[..., None],
-                                  alpha[..., None]], -1)
+        segment = np.concatenate([colour * alpha[..., None], alpha[..., None]], -1)
         image = image + (1.0 - image[..., 3:4]) * segment
     return np.clip(image, 0.0, 1.0)
 
@@ -302,6 +324,13 @@ def shearwarp_naive(volume, view, filt, transfer):
     n_k, n_j, n_i = slices.shape
     h = volume.spacing[axes]
     kf = 0 if ascending else n_k - 1
+    gradients = None
+    if transfer.needs_gradient:  # central differences (world units, x y z), in slice order
+        field = np.asarray(volume.data, float)
+        hx, hy, hz = volume.spacing
+        gradients = [np.transpose(g, (2 - axis, 2 - p_axis, 2 - q_axis)) for g in (
+            np.gradient(field, hx, axis=2), np.gradient(field, hy, axis=1),
+            np.gradient(field, hz, axis=0))]
     eye = None if view.eye is None else (view.eye - volume.origin)[axes] / h
 
     def hit(point, k):  # where the ray through plane point (i, j) meets slice k
@@ -331,12 +360,20 @@ def shearwarp_naive(volume, view, filt, transfer):
                     continue
                 jdx = math.floor(j - filt.radius) + 1 + np.arange(taps)
                 idx = math.floor(i - filt.radius) + 1 + np.arange(taps)
-                patch = slices[k][np.ix_(np.clip(jdx, 0, n_j - 1), np.clip(idx, 0, n_i - 1))]
-                value = filt(j - jdx) @ patch @ filt(i - idx)
+                taps_at = np.ix_(np.clip(jdx, 0, n_j - 1), np.clip(idx, 0, n_i - 1))
+                value = filt(j - jdx) @ slices[k][taps_at] @ filt(i - idx)
                 part = 0.5 if k in (0, n_k - 1) else 1.0  # end slices reach half as far
-                alpha = -np.expm1(-transfer.opacity_density(np.array([value]))[0] * length
-                                  * part)
+                density = transfer.opacity_density(np.array([value]))[0]
                 colour = transfer.emission(np.array([value]))[0]
+                if gradients is not None:
+                    grad = np.array([filt(j - jdx) @ g[k][taps_at] @ filt(i - idx)
+                                     for g in gradients])
+                    if transfer.gradient_opacity is not None:
+                        density *= transfer.gradient_opacity.factor(np.linalg.norm(grad))
+                    if transfer.shading is not None:
+                        colour = (colour * transfer.shading.factor(grad, -view.forward)
+                                  + transfer.shading.highlight(grad, -view.forward))
+                alpha = -np.expm1(-density * length * part)
                 inter[big_j, big_i] += (1 - inter[big_j, big_i, 3]) * np.r_[colour * alpha,
                                                                               alpha]
     return warp_naive(inter, volume, view, axis, q_axis, p_axis, kf, low)

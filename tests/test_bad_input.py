@@ -80,12 +80,11 @@ CASES = [
     ("transfer not a transfer", lambda: render(transfer=lambda v: v), TypeError, r"transfer"),
     ("perspective shear3", lambda: render(method="shear3", view=View.orbit(
         size=8, projection="perspective")), ValueError, r"orthographic only"),
-    ("shaded shear", lambda: render(method="shear2", transfer=Glow(1.0, shading=vrlib.Phong())),
-     ValueError, r"does not shade"),
-    ("shaded shear-warp", lambda: render(method="shearwarp",
-                                         transfer=Glow(1.0, shading=vrlib.Phong())),
-     ValueError, r"does not shade"),
-    ("shaded splatting", lambda: render(method="splat", transfer=Glow(1.0, shading=vrlib.Phong())),
+    ("shaded perspective shear-warp", lambda: render(
+        method="shearwarp", view=View.orbit(size=8, projection="perspective"),
+        transfer=Glow(1.0, shading=vrlib.Phong())), ValueError, r"does not shade"),
+    ("shaded sheet splatting", lambda: render(method="splat",
+                                              transfer=Glow(1.0, shading=vrlib.Phong())),
      ValueError, r"does not shade"),
     ("filter too wide for ray casting", lambda: render(filter=("gaussian", 2.0, 5.0)),
      ValueError, r"radius"),

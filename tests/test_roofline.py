@@ -97,7 +97,8 @@ def test_resampled_lines_and_slices_match_the_filter(filt, ntaps):
         expected = (k(pos[:, None] - taps[None, :]) * lines[n % 3][None, :]).sum(axis=1)
         np.testing.assert_allclose(out[n], expected, rtol=1e-5, atol=1e-6)
     slices = rng.uniform(-1.0, 1.0, (2, 12, 12))
-    wi, wj = k(0.3 - np.arange(ntaps) + (ntaps // 2 - 1)), k(0.6 - np.arange(ntaps) + (ntaps // 2 - 1))
+    offsets = np.arange(ntaps) - (ntaps // 2 - 1)
+    wi, wj = k(0.3 - offsets), k(0.6 - offsets)
     planes = np.empty((3, 8, 8))
     kernels.resample_slices(slices, ntaps, wi, wj, planes)
     for n in range(3):

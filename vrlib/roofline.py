@@ -34,7 +34,8 @@ from vrlib.cost import measure as _time
 from vrlib.footprint import footprint
 from vrlib.view import View
 
-__all__ = ["measure", "ray_caster_ladder", "BRICK", "STEPS", "PIXELS_PER_VOXEL", "SHEET", "LINE", "SLICE"]
+__all__ = ["measure", "ray_caster_ladder", "BRICK", "STEPS", "PIXELS_PER_VOXEL", "SHEET",
+           "LINE", "SLICE"]
 
 #: Samples per side of the cache-resident brick (32^3 float64 is 256 KiB: inside a core's
 #: L2 cache here, 512 KiB).
@@ -69,8 +70,8 @@ def _other_ceilings(repeats, count, rng):
         centres = rng.uniform(reach + 1.0, SHEET - reach - 2.0, (count, 2))
         sheets = np.zeros((tasks, SHEET, SHEET))
         seconds, drawn = _time(lambda fp=fp, centres=centres, sheets=sheets:
-                               _kernel.draw_footprints(fp.table, fp.extent, fp.extent_v, px, centres,
-                                                       sheets), repeats=repeats)
+                               _kernel.draw_footprints(fp.table, fp.extent, fp.extent_v, px,
+                                                       centres, sheets), repeats=repeats)
         out[f"footprint_{name}"] = drawn / seconds
     lines = rng.uniform(0.0, 1.0, (16, LINE)).astype(np.float32)
     resampled = np.empty((max(tasks, count // 16), LINE - 8), np.float32)

@@ -17,7 +17,9 @@ fused with the compositing and no third volume is stored. ``method="shear2"`` dr
 pass 3 only slides samples along their own ray and re-spaces them evenly, so the slices that
 pass 2 leaves on the image's rows and columns are composited in slice order directly, each a
 segment of the same length ``|i| ds`` (one global opacity correction). Both are affine, so
-orthographic only.
+orthographic only. Transfer functions that need gradients (shading, gradient opacity) send the
+samples' central differences through the same passes (:mod:`vrlib.gradients`: four channels
+instead of one) and classify each sample by its resampled gradient.
 """
 
 from __future__ import annotations
@@ -30,7 +32,7 @@ import numpy as np
 
 from vrlib import validate
 from vrlib._kernels import shear as _kernel
-from vrlib.arguments import refuse_gradients
+from vrlib.gradients import gradient_volumes, kernel_lighting, no_gradients
 from vrlib.image import Image, RenderStats
 from vrlib.value_bounds import reconstructed_range
 
@@ -128,9 +130,8 @@ def plan_shear(volume, view, ds):
                      np.array([t0, ty, tz - z_first]))
 
 
-def _check(view, transfer):
+def _check(view):
     """Refuse what three- and two-pass shearing cannot render."""
-    refuse_gradients(transfer, "volume shearing")
     if view.is_perspective:
         raise ValueError("three- and two-pass shearing factor an affine view: orthographic "
                          "only; use method='shearwarp' or 'raycast' for perspective")
@@ -169,38 +170,52 @@ def _run_pass(src, out, c0, c1, c2, offset, lo, hi, filt):
 INTERMEDIATES = {"float32": np.float32, "float64": np.float64}
 
 
-def _passes(volume, view, plan, filt, count, dtype):
-    """Passes 1 and 2; returns ``V2[w, Y, X]`` and the computed output ranges of pass 2.
+def _passes(volume, view, plan, filt, count, dtype, transfer):
+    """Passes 1 and 2; returns ``V2[w, Y, X]``, the gradient's components after the same passes
+    (``[3, w, Y, X]``, when ``transfer`` needs them: :mod:`vrlib.gradients`; else a
+    placeholder, :func:`vrlib.gradients.no_gradients`) and the computed output ranges of pass 2.
 
     Each pass computes only outputs the volume reaches: a line of pass 2 holds data where pass 1
     computed it, and so on.
     """
     u, v, w = plan.order
-    data = np.transpose(volume.data, (2 - w, 2 - v, 2 - u))  # [w, v, u], a view
-    nw, nv, nu = data.shape
-    v1 = np.zeros((nw, nv, view.width), dtype)
-    count["pass1"], first1, last1 = _run_pass(
-        data, v1, plan.a, plan.b, plan.c, plan.t0, np.zeros((nw, nv), np.int64),
-        np.full((nw, nv), nu - 1, np.int64), filt)
-    lo, hi = _filled(first1, last1, view.width)  # pass 2 lines (w, X) run along v
+    order = (2 - w, 2 - v, 2 - u)  # [w, v, u]
+    channels = [volume.data]
+    if transfer.needs_gradient:
+        channels += list(gradient_volumes(volume))
+    nw, nv, nu = np.transpose(volume.data, order).shape
     # V2[w, Y, X] is stored as [Y, w, X]: the samples one image row needs lie together, for
     # the last pass (shear3) or the compositing (shear2), which take an image row at a time.
-    v2 = np.zeros((view.height, nw, view.width), dtype).transpose(1, 0, 2)
-    count["pass2"], first2, last2 = _run_pass(
-        v1.transpose(0, 2, 1), v2.transpose(0, 2, 1), plan.e, plan.d, plan.f, plan.t1, lo, hi,
-        filt)
-    count["buffers"] = v1.nbytes + v2.nbytes
-    del v1
-    return v2, first2, last2
+    stored = np.zeros((len(channels), view.height, nw, view.width), dtype)
+    v2 = stored.transpose(0, 2, 1, 3)
+    v1 = np.empty((nw, nv, view.width), dtype)
+    count["pass1"] = count["pass2"] = 0
+    for channel, data in enumerate(channels):
+        v1[...] = 0.0
+        done, first1, last1 = _run_pass(
+            np.transpose(data, order), v1, plan.a, plan.b, plan.c, plan.t0,
+            np.zeros((nw, nv), np.int64), np.full((nw, nv), nu - 1, np.int64), filt)
+        count["pass1"] += done
+        lo, hi = _filled(first1, last1, view.width)  # pass 2 lines (w, X) run along v
+        done, first2, last2 = _run_pass(
+            v1.transpose(0, 2, 1), v2[channel].transpose(0, 2, 1), plan.e, plan.d, plan.f,
+            plan.t1, lo, hi, filt)
+        count["pass2"] += done
+    count["buffers"] = v1.nbytes + stored.nbytes
+    grads = no_gradients(dtype)
+    if len(channels) > 1:
+        grads = v2[1:]
+        grads.flags.writeable = False  # the placeholder's type: one compiled kernel
+    return v2[0], grads, first2, last2
 
 
-def _first_passes(volume, view, filt, step, dtype):
+def _first_passes(volume, view, filt, step, dtype, transfer):
     """What both methods do first: the ray step in world units, the plan, and passes 1 and 2
     (:func:`_passes`) with their counts."""
     ds = step * float(volume.spacing.min())
     plan = plan_shear(volume, view, ds)
     count = {}
-    return ds, plan, count, _passes(volume, view, plan, filt, count, dtype)
+    return ds, plan, count, _passes(volume, view, plan, filt, count, dtype, transfer)
 
 
 def _stats(volume, taps, count, composited, seconds, largest):
@@ -239,10 +254,11 @@ def render_shear3(volume, view, *, filt, transfer, step, early_termination,
     ``intermediate`` stores the resampled volumes as float32 (half the memory) or float64;
     ``"auto"`` takes float32 unless the volume's magnitudes need float64 (chapter ch08
     measures the difference: about 1e-8 in the image)."""
-    _check(view, transfer)
+    _check(view)
     dtype = _intermediate(intermediate, volume)
     start = time.perf_counter()
-    ds, plan, count, (v2, first2, last2) = _first_passes(volume, view, filt, step, dtype)
+    ds, plan, count, (v2, grads, first2, last2) = _first_passes(volume, view, filt, step, dtype,
+                                                                 transfer)
     # Pass 3 runs along the rays: fused with compositing, no third volume is stored.
     lo, hi = _filled(first2.transpose(1, 0), last2.transpose(1, 0), view.height)  # [X, Y]
     tables = transfer.segment_table(ds, *reconstructed_range(volume, filt))
@@ -253,8 +269,9 @@ def render_shear3(volume, view, *, filt, transfer, step, early_termination,
     _kernel.resample_composite(
         v2.transpose(1, 2, 0), plan.i, plan.g, plan.h, plan.t2, np.ascontiguousarray(lo.T),
         np.ascontiguousarray(hi.T), *filt.code, filt.radius, filt.taps, plan.depth_samples,
-        np.linalg.inv(plan.matrix), plan.shift, limits, *tables[:4], early_termination, out,
-        resampled, counts)
+        np.linalg.inv(plan.matrix), plan.shift, limits, *tables,
+        grads.transpose(0, 2, 3, 1), *kernel_lighting(transfer, view.forward), early_termination,
+        out, resampled, counts)
     count["pass3"] = int(resampled.sum())
     largest = max(count["buffers"], v2.nbytes)
     del v2
@@ -268,10 +285,10 @@ def render_shear2(volume, view, *, filt, transfer, step, early_termination,
     """Two-pass shear rendering (arguments validated by :func:`vrlib.render`). ``step`` sets
     the lattice of the image plane only: samples along a ray are the volume's slices.
     ``intermediate`` as for :func:`render_shear3`."""
-    _check(view, transfer)
+    _check(view)
     dtype = _intermediate(intermediate, volume)
     start = time.perf_counter()
-    ds, plan, count, (v2, _, _) = _first_passes(volume, view, filt, step, dtype)
+    ds, plan, count, (v2, grads, _, _) = _first_passes(volume, view, filt, step, dtype, transfer)
     length = abs(plan.i) * ds  # world distance between slices along a ray
     tables = transfer.segment_table(length, *reconstructed_range(volume, filt))
     m = plan.matrix
@@ -280,8 +297,9 @@ def render_shear2(volume, view, *, filt, transfer, step, early_termination,
     limits = np.array(volume.shape[::-1], float)[list(plan.order)][:2] - 1.0
     out = np.zeros(view.shape + (4,))
     counts = np.zeros(view.height, np.int64)
-    _kernel.composite_slices(v2, plan.i > 0, inverse2, shift, limits, tables[0], tables[1],
-                             tables[2], tables[3], early_termination, out, counts)
+    _kernel.composite_slices(v2, plan.i > 0, inverse2, shift, limits, *tables, grads,
+                             *kernel_lighting(transfer, view.forward), early_termination, out,
+                             counts)
     stats = _stats(volume, filt.taps, count, int(counts.sum()), time.perf_counter() - start,
                    count["buffers"])
     return Image(np.clip(out, 0.0, 1.0), stats)

@@ -6,7 +6,11 @@ the view becomes a projection along that axis, each resampled in 2-D with the ch
 composited front to back into an intermediate image at the front slice's resolution; the
 intermediate image is then warped to the final one with bilinear interpolation. Runs of
 transparent voxels are skipped (:func:`vrlib.skipping.transparent_runs`), Lacroute's
-run-length encoding.
+run-length encoding. Transfer functions that need gradients (shading, gradient opacity) take the
+samples' central differences resampled with the same weights (:mod:`vrlib.gradients`);
+perspective views take gradient opacity but not shading (one ray direction per intermediate
+pixel is not implemented). :func:`vrlib.classify` is VolPack's form of the method, with
+classification and shading before resampling.
 """
 
 from __future__ import annotations
@@ -19,6 +23,7 @@ import numpy as np
 from vrlib import validate
 from vrlib._kernels import shear as _kernel
 from vrlib.arguments import refuse_gradients
+from vrlib.gradients import gradient_volumes, kernel_lighting, no_gradients
 from vrlib.image import Image, RenderStats
 from vrlib.skipping import transparent_runs
 from vrlib.value_bounds import lattice_sums, reconstructed_range
@@ -140,7 +145,9 @@ def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
     """
     min_opacity = validate.finite_number("min_opacity", min_opacity, low=0.0, high=1.0,
                                           high_open=True)
-    refuse_gradients(transfer, "shear-warp")
+    if view.is_perspective and transfer.shading is not None:
+        refuse_gradients(transfer, "perspective shear-warp", "an orthographic view, "
+                         "method='raycast' or method='splat' with mode='direct'")
     ntaps = filt.taps
     start = time.perf_counter()
     axis, ascending = principal_axis(view, volume)
@@ -172,9 +179,13 @@ def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
     first, last = transparent_runs(volume, axis, bound)
     inter = np.zeros((height, width, 4))
     counts = np.zeros(height, np.int64)
+    grads = no_gradients(np.float32)
+    if transfer.needs_gradient:  # the gradient's components in slice order, like ``slices``
+        grads = gradient_volumes(volume).transpose(
+            {2: (0, 1, 2, 3), 1: (0, 2, 1, 3), 0: (0, 3, 1, 2)}[axis])
     _kernel.shear_slices(slices, order, scale, di, dj, fraction, *filt.code, filt.radius,
-                         ntaps, tables[0], tables[1], tables[2], tables[3], early_termination,
-                         first, last, inter, counts)
+                         ntaps, *tables, grads, *kernel_lighting(transfer, view.forward),
+                         early_termination, first, last, inter, counts)
     # The warp: where each pixel's ray meets the front slice, in intermediate coordinates.
     plane = volume.origin[axis] + kf * h[axis]
     out = np.empty(view.shape + (4,))

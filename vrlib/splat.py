@@ -26,6 +26,7 @@ from vrlib._kernels import splat as _kernel
 from vrlib._scheduling import balanced_order
 from vrlib.arguments import refuse_gradients
 from vrlib.footprint import RADIAL, footprint
+from vrlib.gradients import SLAB, gradient_volumes
 from vrlib.image import Image, RenderStats
 from vrlib.value_bounds import reconstructed_range
 from vrlib.view import principal_axis
@@ -65,19 +66,15 @@ def drawable(volume, transfer, mode):
     return mask
 
 
-#: z-slices classified at a time by :func:`classify_voxels` (bounds its scratch memory).
-SLAB = 16
-
-
 def classify_voxels(volume, view, transfer):
     """Each voxel's opacity density and colour, for a transfer function that needs gradients
     (shading, gradient opacity): direct splatting classifies and shades the voxels before
     reconstruction (Westover's pre-shaded splats), as VolPack does, where the ray caster
     classifies reconstructed samples.
 
-    The gradient is the samples' central difference in world units (one-sided on the faces,
-    :func:`numpy.gradient`); a voxel is seen along the view's direction, or in perspective along
-    the ray from the eye through its centre.
+    The gradient is the samples' central difference in world units
+    (:func:`vrlib.gradients.gradient_volumes`); a voxel is seen along the view's direction, or
+    in perspective along the ray from the eye through its centre.
 
     Returns
     -------
@@ -89,25 +86,21 @@ def classify_voxels(volume, view, transfer):
     Examples
     --------
     >>> from vrlib import Volume, View, Glow, GradientOpacity
-    >>> ramp = Volume(np.tile(np.linspace(0.0, 1.0, 4), (4, 4, 1)))   # slope 1.5 along x
-    >>> glow = Glow(2.0, gradient_opacity=GradientOpacity([0.0, 3.0], [0.0, 1.0]))
+    >>> ramp = Volume(np.tile(np.linspace(0.0, 1.0, 4), (4, 4, 1)))   # slope 0.5 along x
+    >>> glow = Glow(2.0, gradient_opacity=GradientOpacity([0.0, 1.0], [0.0, 1.0]))
     >>> density, colour = classify_voxels(ramp, View.orbit(size=8), glow)
-    >>> density[0, 0].round(3).tolist()     # 2 f times 1.5 / 3
+    >>> [round(float(d), 3) for d in density[0, 0]]     # 2 f times the factor 0.5
     [0.0, 0.333, 0.667, 1.0]
     """
     nz = volume.shape[0]
     density = np.empty(volume.shape, np.float32)
     colour = np.empty(volume.shape + (3,), np.float32)
-    hx, hy, hz = volume.spacing
+    gradients = gradient_volumes(volume)
     ramp, shading = transfer.gradient_opacity, transfer.shading
     for z0 in range(0, nz, SLAB):
         z1 = min(z0 + SLAB, nz)
-        lo, hi = max(z0 - 1, 0), min(z1 + 1, nz)  # a neighbour slice each side, where one is
-        block = np.asarray(volume.data[lo:hi], np.float64)
-        parts = [np.gradient(block, hz, axis=0) if hi - lo > 1 else np.zeros_like(block),
-                 np.gradient(block, hy, axis=1), np.gradient(block, hx, axis=2)]
-        grad = np.stack(parts[::-1], axis=-1)[z0 - lo:z1 - lo]  # (x, y, z) components
-        f = block[z0 - lo:z1 - lo]
+        grad = np.moveaxis(gradients[:, z0:z1], 0, -1).astype(np.float64)
+        f = np.asarray(volume.data[z0:z1], np.float64)
         sigma = transfer.opacity_density(f)
         if ramp is not None:
             sigma = sigma * ramp.factor(np.linalg.norm(grad, axis=-1))
@@ -209,7 +202,8 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
         slices, fp.kind, fp.extent, fp.extent_v or fp.extent,
         fp.table if fp.kind == RADIAL else dummy1,
         fp.table if fp.kind != RADIAL else dummy2, MODES.index(mode), vstart, vinv, density,
-        emission, per_voxel, voxel_density, voxel_colour, early_termination, empty_space_skipping, first, last, reach_max, BAND,
+        emission, per_voxel, voxel_density, voxel_colour, early_termination,
+        empty_space_skipping, first, last, reach_max, BAND,
         balanced_order(np.ones(bands), numba.get_num_threads()), out, voxels, pixels,
     )
     drawn = int(pixels.sum())

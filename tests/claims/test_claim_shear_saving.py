@@ -3,10 +3,11 @@ is unnecessary; dropping it saves about 30% of computation and memory".
 
 Chapter ch05 measured it over 50 random rotations at 128^3. Checked here over 6 seeded random
 rotations at 48^3 (one pixel and one ray sample per voxel, Catmull-Rom): the two-pass method
-resamples at least 25% fewer samples, keeps at least 25% less in its buffers, and is as
-accurate on average: its rmse over the three-pass rmse, averaged over the rotations, is below
-1.1. View by view the ratio varies (measured 0.75 to 1.30 at these rotations), because the
-two methods sample different points along each ray.
+resamples at least 25% fewer samples and is as accurate on average: its rmse over the
+three-pass rmse, averaged over the rotations, is below 1.1 (view by view the ratio varies,
+measured 0.75 to 1.30 at these rotations, because the two methods sample different points
+along each ray). The memory saving holds only against a three-pass method that stores its
+third volume, which vrlib's does not.
 """
 
 import numpy as np
@@ -40,10 +41,15 @@ def test_two_pass_saves_a_quarter_or_more_of_the_resampling(renders):
     assert np.mean(ratios) < 0.75
 
 
-@pytest.mark.claim(6, "supports")
-def test_two_pass_saves_a_quarter_or_more_of_the_buffers(renders):
+@pytest.mark.claim(6, "beyond")
+def test_a_fused_third_pass_needs_no_buffer(renders):
+    """The memory half of the claim assumes a three-pass method that stores its third volume
+    before compositing. vrlib's three-pass method runs its last pass along the rays, fused with
+    the compositing, so it holds the same two intermediate volumes as the two-pass method: the
+    memory saved by dropping the pass is gone (ratio 1), while the computation saved stays
+    (above)."""
     ratios = [p["shear2"].stats.bytes / p["shear3"].stats.bytes for p, _ in renders]
-    assert np.mean(ratios) < 0.75
+    np.testing.assert_allclose(ratios, 1.0)
 
 
 @pytest.mark.claim(6, "supports")

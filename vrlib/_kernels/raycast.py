@@ -21,8 +21,8 @@ from vrlib._kernels._jit import jit, parallel_jit
 from vrlib._kernels.camera import pixel_ray, ray_box
 from vrlib._kernels.filters import CUBIC, MAX_TAPS, TENT
 from vrlib._kernels.sampling import gradient, reconstruct, separable4, tricubic, trilinear
-from vrlib._kernels.shading import phong
-from vrlib._kernels.tables import interpolate_channel, lookup, piecewise_linear
+from vrlib._kernels.shading import classify_by_gradient
+from vrlib._kernels.tables import lookup
 
 
 @jit
@@ -205,46 +205,23 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, camera, heigh
                         continue  # a transparent segment adds exactly nothing
                     if grey and not by_gradient:
                         cr = cg = cb = alpha  # white emission, no shading: colour = opacity
-                    else:
-                        gx_ = gy_ = gz_ = 0.0
-                        if shade or by_gradient:
-                            gx_, gy_, gz_ = gradient(data, offset, gshape, ux, uy, uz, fkind,
-                                                     fp0, fp1, fp2, radius, ntaps, wx, wy, wz,
-                                                     dx, dy, dz)
-                            gx_ *= inv[0]
-                            gy_ *= inv[1]
-                            gz_ *= inv[2]
-                        if by_gradient:
-                            # Density times g(|grad F|): alpha = 1 - (1 - alpha)^g (eq 1.4).
-                            norm = math.sqrt(gx_ * gx_ + gy_ * gy_ + gz_ * gz_)
-                            g = piecewise_linear(ramp_x, ramp_y, norm)
-                            if not g > 0.0:
-                                continue
-                            if g < 1.0 and alpha < 1.0:
-                                alpha = -math.expm1(g * math.log1p(-alpha))
-                        if grey:
-                            cr = cg = cb = alpha
-                        elif shade:
-                            if headlight:
-                                lx, ly, lz = -d[0], -d[1], -d[2]
-                            else:
-                                lx, ly, lz = light[0], light[1], light[2]
-                            factor, spec = phong(gx_, gy_, gz_, lx, ly, lz, d[0], d[1], d[2],
-                                                 ka, kd, ks, shininess)
-                            er = emit_tab[i, 0] + w * (emit_tab[i + 1, 0] - emit_tab[i, 0])
-                            eg = emit_tab[i, 1] + w * (emit_tab[i + 1, 1] - emit_tab[i, 1])
-                            eb = emit_tab[i, 2] + w * (emit_tab[i + 1, 2] - emit_tab[i, 2])
-                            cr = (er * factor + spec) * alpha
-                            cg = (eg * factor + spec) * alpha
-                            cb = (eb * factor + spec) * alpha
-                        elif by_gradient:
-                            cr = interpolate_channel(emit_tab, tstart, tinv, value, 0) * alpha
-                            cg = interpolate_channel(emit_tab, tstart, tinv, value, 1) * alpha
-                            cb = interpolate_channel(emit_tab, tstart, tinv, value, 2) * alpha
+                    elif shade or by_gradient:
+                        gx_, gy_, gz_ = gradient(data, offset, gshape, ux, uy, uz, fkind, fp0,
+                                                 fp1, fp2, radius, ntaps, wx, wy, wz, dx, dy, dz)
+                        if headlight:
+                            lx, ly, lz = -d[0], -d[1], -d[2]
                         else:
-                            cr = color_tab[i, 0] + w * (color_tab[i + 1, 0] - color_tab[i, 0])
-                            cg = color_tab[i, 1] + w * (color_tab[i + 1, 1] - color_tab[i, 1])
-                            cb = color_tab[i, 2] + w * (color_tab[i + 1, 2] - color_tab[i, 2])
+                            lx, ly, lz = light[0], light[1], light[2]
+                        alpha, cr, cg, cb = classify_by_gradient(
+                            alpha, i, w, emit_tab, gx_ * inv[0], gy_ * inv[1], gz_ * inv[2],
+                            by_gradient, ramp_x, ramp_y, shade, lx, ly, lz, d[0], d[1], d[2],
+                            ka, kd, ks, shininess)
+                        if not alpha > 0.0:
+                            continue
+                    else:
+                        cr = color_tab[i, 0] + w * (color_tab[i + 1, 0] - color_tab[i, 0])
+                        cg = color_tab[i, 1] + w * (color_tab[i + 1, 1] - color_tab[i, 1])
+                        cb = color_tab[i, 2] + w * (color_tab[i + 1, 2] - color_tab[i, 2])
                     # Front-to-back over, eqs 1.7-1.8.
                     remaining = 1.0 - acc_a
                     acc_r += remaining * cr

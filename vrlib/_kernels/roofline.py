@@ -17,8 +17,8 @@ import numpy as np
 from numba import prange
 
 from vrlib._kernels._jit import parallel_jit
+from vrlib._kernels.footprint import planar_at, planar_row
 from vrlib._kernels.sampling import cubic_weights, lerp_corners, trilinear
-from vrlib._kernels.splat import planar_at, planar_row
 from vrlib._kernels.tables import lookup
 
 
@@ -73,9 +73,10 @@ def sample_rays(brick, starts, direction, steps, cubic, b, c, out):
 @parallel_jit
 def draw_footprints(planar, extent, extent_v, px, centres, sheets):
     """Splatting's inner loop alone: footprint ``planar`` (a planar table reaching ``extent``
-    and ``extent_v`` world units along the image's right and up, pixels ``px`` wide) drawn at each ``centres[n] = (row, col)`` into one
-    cache-resident sheet per task (``sheets[t]``), over the pixels the table reaches, with
-    unit voxel values. Orthographic: each row's table row is found once. Returns the pixels drawn."""
+    and ``extent_v`` world units along the image's right and up, pixels ``px`` wide) drawn at
+    each ``centres[n] = (row, col)`` into one cache-resident sheet per task (``sheets[t]``),
+    over the pixels the table reaches, with unit voxel values. Orthographic: each row's table
+    row is found once. Returns the pixels drawn."""
     tasks = sheets.shape[0]
     reach_u = extent / px
     reach_v = extent_v / px

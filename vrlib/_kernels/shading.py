@@ -6,6 +6,7 @@ from __future__ import annotations
 import math
 
 from vrlib._kernels._jit import jit
+from vrlib._kernels.tables import piecewise_linear
 
 
 @jit(inline="always")
@@ -58,3 +59,28 @@ def phong(gx, gy, gz, lx, ly, lz, dx, dy, dz, ka, kd, ks, shininess):
     of ``l`` and ``-d``."""
     hx, hy, hz = half_vector(lx, ly, lz, dx, dy, dz)
     return phong_terms(gx, gy, gz, lx, ly, lz, hx, hy, hz, ka, kd, ks, shininess)
+
+
+@jit(inline="always")
+def classify_by_gradient(alpha, i, w, emit_tab, gx, gy, gz, by_gradient, ramp_x, ramp_y,
+                         shade, lx, ly, lz, dx, dy, dz, ka, kd, ks, shininess):
+    """A sample's segment opacity and premultiplied colour when its classification needs its
+    gradient ``g`` (world units): ``alpha`` and the table position ``(i, w)`` come from its
+    value; with ``by_gradient`` the density is multiplied by the piecewise-linear factor through
+    ``(ramp_x, ramp_y)`` of ``|g|`` (``alpha = 1 - (1 - alpha)^factor``, eq 1.4); with
+    ``shade`` the emission ``emit_tab`` is Phong-shaded for light direction ``l`` and ray
+    direction ``d``. Returns ``(alpha, r, g, b)``; ``alpha = 0`` adds nothing."""
+    if by_gradient:
+        factor = piecewise_linear(ramp_x, ramp_y, math.sqrt(gx * gx + gy * gy + gz * gz))
+        if not factor > 0.0:
+            return 0.0, 0.0, 0.0, 0.0
+        if factor < 1.0 and alpha < 1.0:
+            alpha = -math.expm1(factor * math.log1p(-alpha))
+    er = emit_tab[i, 0] + w * (emit_tab[i + 1, 0] - emit_tab[i, 0])
+    eg = emit_tab[i, 1] + w * (emit_tab[i + 1, 1] - emit_tab[i, 1])
+    eb = emit_tab[i, 2] + w * (emit_tab[i + 1, 2] - emit_tab[i, 2])
+    if shade:
+        lit, spec = phong(gx, gy, gz, lx, ly, lz, dx, dy, dz, ka, kd, ks, shininess)
+        return (alpha, (er * lit + spec) * alpha, (eg * lit + spec) * alpha,
+                (eb * lit + spec) * alpha)
+    return alpha, er * alpha, eg * alpha, eb * alpha

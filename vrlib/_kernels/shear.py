@@ -18,7 +18,8 @@ from numba import prange
 
 from vrlib._kernels._jit import jit, parallel_jit
 from vrlib._kernels.filters import CUBIC, MAX_TAPS, TENT, weight
-from vrlib._kernels.sampling import filter_taps, clamp, cubic_weights
+from vrlib._kernels.sampling import clamp, cubic_weights, filter_taps
+from vrlib._kernels.shading import classify_by_gradient
 from vrlib._kernels.tables import lookup
 
 
@@ -45,6 +46,12 @@ def _resample(src, s, r, lo, hi, pos, fkind, fp0, fp1, fp2, radius, ntaps, w):
     """Line ``src[s, r]`` (data on ``lo .. hi``) reconstructed at ``pos``; taps clamped to the
     data only near its ends."""
     first = _line_taps(fkind, fp0, fp1, fp2, radius, ntaps, pos, w)
+    return _taps_sum(src, s, r, lo, hi, first, ntaps, w)
+
+
+@jit(inline="always")
+def _taps_sum(src, s, r, lo, hi, first, ntaps, w):
+    """Taps ``first ..`` of line ``src[s, r]`` weighted by ``w``, clamped to ``lo .. hi``."""
     acc = 0.0
     if first >= lo and first + ntaps - 1 <= hi:
         for a in range(ntaps):
@@ -175,20 +182,50 @@ def _inside_range(inverse, shift, limits, x, y, n):
     return max(0, int(math.floor(z_lo)) - 1), min(n - 1, int(math.ceil(z_hi)) + 1)
 
 
+@jit(inline="always")
+def _over_lit(value, fraction, gx, gy, gz, tstart, tinv, alpha_tab, emit_tab, lit, ramp_x,
+              ramp_y, buf, y, x):
+    """:func:`_over` for a sample classified by its gradient ``g`` too (shading, gradient
+    opacity; ``lit``, ``ramp_x``, ``ramp_y`` from :func:`vrlib.gradients.kernel_lighting`)."""
+    i, w = lookup((value - tstart) * tinv, alpha_tab.shape[0])
+    alpha = alpha_tab[i] + w * (alpha_tab[i + 1] - alpha_tab[i])
+    if not alpha > 0.0:
+        return
+    alpha, cr, cg, cb = classify_by_gradient(
+        alpha, i, w, emit_tab, gx, gy, gz, lit[2] != 0.0, ramp_x, ramp_y, lit[0] != 0.0,
+        lit[7], lit[8], lit[9], lit[10], lit[11], lit[12], lit[3], lit[4], lit[5], lit[6])
+    if not alpha > 0.0:
+        return
+    if fraction != 1.0:
+        corrected = -math.expm1(fraction * math.log1p(-alpha))
+        scale = corrected / alpha
+        cr, cg, cb, alpha = cr * scale, cg * scale, cb * scale, corrected
+    remaining = 1.0 - buf[y, x, 3]
+    buf[y, x, 0] += remaining * cr
+    buf[y, x, 1] += remaining * cg
+    buf[y, x, 2] += remaining * cb
+    buf[y, x, 3] += remaining * alpha
+
+
 @parallel_jit
 def resample_composite(src, c0, c1, c2, offset, line_lo, line_hi, fkind, fp0, fp1, fp2, radius,
                        ntaps, n_z, inverse, shift, limits, tstart, tinv, alpha_tab, color_tab,
-                       threshold, out, resampled, composited):
+                       emit_tab, grads, lit, ramp_x, ramp_y, threshold, out, resampled,
+                       composited):
     """Three-pass shearing's last pass fused with its compositing: the pass-3 line of pixel
     ``(x, y)`` is that pixel's ray. ``src[y, x, w]`` is pass 2's output seen along the lines of
     pass 3 (``line_lo .. line_hi`` filled, as for :func:`shear_pass`); lattice sample ``z`` of
     the ray is the line resampled at ``(z - offset - c1 x - c2 y) / c0`` where :func:`shear_pass`
     would compute it and 0 elsewhere, and it is composited front to back (increasing ``z``) into
     ``out`` when it lies in the volume (the lattice sample ``inverse @ ((x, y, z) - shift)``
-    within ``[0, limits]``). The pixels of a row advance together (contiguous reads of ``src``); opaque pixels
-    take no more samples. ``resampled[y]`` and ``composited[y]`` count the work."""
+    within ``[0, limits]``). The pixels of a row advance together (contiguous reads of
+    ``src``); opaque pixels take no more samples. ``resampled[y]`` and ``composited[y]`` count
+    the work. With ``grads`` (``[3, y, x, w]``: the gradient's components after pass 2;
+    ``no_gradients()`` for none) each sample's gradient is resampled with the same weights and
+    the sample is classified by it too (:func:`_over_lit`)."""
     height, width = out.shape[0], out.shape[1]
     n = src.shape[2]
+    lighting = lit[0] != 0.0 or lit[2] != 0.0  # shading or gradient opacity
     for row_index in prange(height):
         y = np.int64(row_index)
         w = np.empty(MAX_TAPS)
@@ -227,29 +264,42 @@ def resample_composite(src, c0, c1, c2, offset, line_lo, line_hi, fkind, fp0, fp
                         inside = False
                 if not inside:
                     continue
-                value = 0.0
+                value = gx = gy = gz = 0.0
                 if q_first[x] <= z <= q_last[x]:
-                    value = _resample(src, y, x, max(0, line_lo[y, x]), min(n - 1, line_hi[y, x]),
-                                      (z - (offset + c1 * x + c2 * y)) / c0, fkind, fp0, fp1,
-                                      fp2, radius, ntaps, w)
+                    lo = max(0, line_lo[y, x])
+                    hi = min(n - 1, line_hi[y, x])
+                    first = _line_taps(fkind, fp0, fp1, fp2, radius, ntaps,
+                                       (z - (offset + c1 * x + c2 * y)) / c0, w)
+                    value = _taps_sum(src, y, x, lo, hi, first, ntaps, w)
+                    if lighting:
+                        gx = _taps_sum(grads[0], y, x, lo, hi, first, ntaps, w)
+                        gy = _taps_sum(grads[1], y, x, lo, hi, first, ntaps, w)
+                        gz = _taps_sum(grads[2], y, x, lo, hi, first, ntaps, w)
                     taken += 1
                 done += 1
-                _over(value, 1.0, tstart, tinv, alpha_tab, color_tab, out, y, x)
+                if lighting:
+                    _over_lit(value, 1.0, gx, gy, gz, tstart, tinv, alpha_tab, emit_tab, lit,
+                              ramp_x, ramp_y, out, y, x)
+                else:
+                    _over(value, 1.0, tstart, tinv, alpha_tab, color_tab, out, y, x)
         resampled[y] = taken
         composited[y] = done
 
 
 @parallel_jit
 def composite_slices(vol, front_to_back, inverse2, shift, limits, tstart, tinv, alpha_tab,
-                     color_tab, threshold, out, counts):
+                     color_tab, emit_tab, grads, lit, ramp_x, ramp_y, threshold, out, counts):
     """Two-pass compositing: ``vol[w, Y, X]`` holds slice ``w`` resampled onto the image's
     rows and columns; each pixel composites the slices in view order, each a segment of the
     same length (the table's) but the first and last, which reach half as far into the volume.
     Sample ``(X, Y)`` of slice ``w`` belongs to the volume when
     ``(u, v) = inverse2 @ ((X, Y) - shift[:2] - w shift[2:])`` lies within ``limits``. The
     pixels of a row advance together, slice by slice (contiguous reads); each pixel visits only
-    the slices its ray can meet inside the volume."""
+    the slices its ray can meet inside the volume. With ``grads`` (``[3, w, Y, X]``, the
+    gradient's components resampled like ``vol``; ``no_gradients()`` for none) samples are
+    classified by their gradient too (:func:`_over_lit`)."""
     n_w, height, width = vol.shape
+    lighting = lit[0] != 0.0 or lit[2] != 0.0  # shading or gradient opacity
     for row_index in prange(height):
         y = np.int64(row_index)
         w_first = np.empty(width, np.int64)
@@ -288,13 +338,40 @@ def composite_slices(vol, front_to_back, inverse2, shift, limits, tstart, tinv, 
                 if u < 0.0 or u > limits[0] or v < 0.0 or v > limits[1]:
                     continue
                 done += 1
-                _over(vol[w, y, x], end, tstart, tinv, alpha_tab, color_tab, out, y, x)
+                if lighting:
+                    _over_lit(vol[w, y, x], end, grads[0, w, y, x], grads[1, w, y, x],
+                              grads[2, w, y, x], tstart, tinv, alpha_tab, emit_tab, lit,
+                              ramp_x, ramp_y, out, y, x)
+                else:
+                    _over(vol[w, y, x], end, tstart, tinv, alpha_tab, color_tab, out, y, x)
         counts[y] = done
+
+
+@jit(inline="always")
+def _slice_sum(slices, k, rows, i0, ntaps, wi, wj):
+    """Slice ``k`` at taps ``i0 ..`` of rows ``rows``, weighted ``wi`` along and ``wj`` across
+    the rows; columns clamped to the slice only near its ends."""
+    n_i = slices.shape[2]
+    value = 0.0
+    if i0 >= 0 and i0 + ntaps <= n_i:
+        for b in range(ntaps):
+            line = 0.0
+            for a in range(ntaps):
+                line += wi[a] * slices[k, rows[b], i0 + a]
+            value += wj[b] * line
+    else:
+        for b in range(ntaps):
+            line = 0.0
+            for a in range(ntaps):
+                line += wi[a] * slices[k, rows[b], clamp(i0 + a, n_i)]
+            value += wj[b] * line
+    return value
 
 
 @parallel_jit
 def shear_slices(slices, order, scale, di, dj, fraction, fkind, fp0, fp1, fp2, radius, ntaps,
-                 tstart, tinv, alpha_tab, color_tab, threshold, first, last, inter, counts):
+                 tstart, tinv, alpha_tab, color_tab, emit_tab, grads, lit, ramp_x, ramp_y,
+                 threshold, first, last, inter, counts):
     """Shear-warp's compositing into the intermediate image (Lacroute and Levoy 1994).
 
     ``slices[k, j, i]`` is the volume in slice order. Intermediate pixel ``(I, J)`` samples
@@ -305,8 +382,11 @@ def shear_slices(slices, order, scale, di, dj, fraction, fkind, fp0, fp1, fp2, r
     segment of the table's length times ``fraction[J, I]`` (shape ``(1, 1)``: 1 everywhere),
     halved on the first and last slice. Row ``j`` of slice ``k`` holds nothing visible outside
     columns ``first[k, j] .. last[k, j]``; pixels whose opacity has reached ``threshold`` take
-    no more. Each task owns intermediate rows: no races.
+    no more. Each task owns intermediate rows: no races. With ``grads`` (``[3, k, j, i]``, the
+    gradient's components in slice order; ``no_gradients()`` for none) each sample's gradient is
+    resampled with the same weights and the sample classified by it too (:func:`_over_lit`).
     """
+    lighting = lit[0] != 0.0 or lit[2] != 0.0  # shading or gradient opacity
     n_k, n_j, n_i = slices.shape
     height, width = inter.shape[0], inter.shape[1]
     uniform = fraction.shape[0] == 1
@@ -354,22 +434,16 @@ def shear_slices(slices, order, scale, di, dj, fraction, fkind, fp0, fp1, fp2, r
                     i0 = int(math.floor(i - radius)) + 1
                     for a in range(ntaps):
                         wi[a] = weight(fkind, fp0, fp1, fp2, i - (i0 + a))
-                value = 0.0
-                if i0 >= 0 and i0 + ntaps <= n_i:
-                    for b in range(ntaps):
-                        line = 0.0
-                        for a in range(ntaps):
-                            line += wi[a] * slices[k, rows[b], i0 + a]
-                        value += wj[b] * line
-                else:
-                    for b in range(ntaps):
-                        line = 0.0
-                        for a in range(ntaps):
-                            line += wi[a] * slices[k, rows[b], clamp(i0 + a, n_i)]
-                        value += wj[b] * line
+                value = _slice_sum(slices, k, rows, i0, ntaps, wi, wj)
                 done += 1
                 part = end if uniform else end * fraction[big_j, big_i]
-                _over(value, part, tstart, tinv, alpha_tab, color_tab, inter, big_j, big_i)
+                if lighting:
+                    _over_lit(value, part, _slice_sum(grads[0], k, rows, i0, ntaps, wi, wj),
+                              _slice_sum(grads[1], k, rows, i0, ntaps, wi, wj),
+                              _slice_sum(grads[2], k, rows, i0, ntaps, wi, wj), tstart, tinv,
+                              alpha_tab, emit_tab, lit, ramp_x, ramp_y, inter, big_j, big_i)
+                else:
+                    _over(value, part, tstart, tinv, alpha_tab, color_tab, inter, big_j, big_i)
         counts[big_j] = done
 
 
