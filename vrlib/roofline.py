@@ -25,6 +25,8 @@ can sample faster on this machine without a different algorithm.
 
 from __future__ import annotations
 
+import contextlib
+
 import numba
 import numpy as np
 
@@ -48,6 +50,18 @@ PIXELS_PER_VOXEL = 1.15
 #: Sheet side (pixels), line length and slice side (samples) of the other ceilings: each
 #: task's working set stays in its core's L2 cache.
 SHEET, LINE, SLICE = 64, 256, 64
+
+
+@contextlib.contextmanager
+def _threads(threads):
+    """Run the block on ``threads`` threads (``None``: numba's setting), then restore it."""
+    previous = numba.get_num_threads()
+    if threads is not None:
+        numba.set_num_threads(validate.positive_int("threads", threads))
+    try:
+        yield
+    finally:
+        numba.set_num_threads(previous)
 
 
 def _rays(count, direction, seed=0):
@@ -124,10 +138,7 @@ def measure(*, threads=None, repeats=5, elements=1 << 24, rays=1 << 16):
     repeats = validate.positive_int("repeats", repeats)
     elements = validate.positive_int("elements", elements)
     rays = validate.positive_int("rays", rays)
-    previous = numba.get_num_threads()
-    if threads is not None:
-        numba.set_num_threads(validate.positive_int("threads", threads))
-    try:
+    with _threads(threads):
         a, b, c = (np.full(elements, v) for v in (0.0, 1.0, 2.0))
         seconds, _ = _time(lambda: _kernel.triad(a, b, c, 3.0), repeats=repeats)
         out = {"bandwidth": 24.0 * elements / seconds}
@@ -145,8 +156,6 @@ def measure(*, threads=None, repeats=5, elements=1 << 24, rays=1 << 16):
         out.update(_other_ceilings(repeats, rays, rng))
         out["threads"] = numba.get_num_threads()
         return out
-    finally:
-        numba.set_num_threads(previous)
 
 
 def ray_caster_ladder(*, threads=None, repeats=5, rays=1 << 16):
@@ -164,10 +173,7 @@ def ray_caster_ladder(*, threads=None, repeats=5, rays=1 << 16):
     """
     repeats = validate.positive_int("repeats", repeats)
     rays = validate.positive_int("rays", rays)
-    previous = numba.get_num_threads()
-    if threads is not None:
-        numba.set_num_threads(validate.positive_int("threads", threads))
-    try:
+    with _threads(threads):
         direction = np.array([0.36, 0.48, 0.8])
         starts = _rays(rays, direction)
         brick = np.random.default_rng(1).uniform(0.0, 1.0, (BRICK,) * 3)
@@ -183,5 +189,3 @@ def ray_caster_ladder(*, threads=None, repeats=5, rays=1 << 16):
                 brick, starts, direction, STEPS, True, 0.0, 255.0, table, sums),
         }
         return {name: samples / _time(run, repeats=repeats)[0] for name, run in runs.items()}
-    finally:
-        numba.set_num_threads(previous)

@@ -23,7 +23,7 @@ from vrlib._kernels.shading import classify_by_gradient
 from vrlib._kernels.tables import lookup
 
 
-@jit(inline="always")
+@jit
 def _line_taps(fkind, fp0, fp1, fp2, radius, ntaps, pos, w):
     """First tap of position ``pos`` on a line, its ``ntaps`` weights in ``w``: closed forms for
     the tent (2 taps) and the cubics (4 taps, the pieces evaluated once each), the filter's
@@ -159,6 +159,18 @@ def _over(value, fraction, tstart, tinv, alpha_tab, color_tab, buf, y, x):
 
 
 @jit(inline="always")
+def _within(u0, slope, limit, t_lo, t_hi):
+    """Narrow ``[t_lo, t_hi]`` to where ``0 <= u0 + slope t <= limit`` (empty: ``t_lo > t_hi``)."""
+    if slope == 0.0:
+        if u0 < 0.0 or u0 > limit:
+            return 1.0, 0.0
+        return t_lo, t_hi
+    t0 = -u0 / slope
+    t1 = (limit - u0) / slope
+    return max(t_lo, min(t0, t1)), min(t_hi, max(t0, t1))
+
+
+@jit(inline="always")
 def _inside_range(inverse, shift, limits, x, y, n):
     """The ``z`` in ``[0, n)`` that can lie inside the volume on the lattice ray through
     ``(x, y)``: where ``0 <= inverse @ ((x, y, z) - shift) <= limits`` on every axis, widened
@@ -168,21 +180,13 @@ def _inside_range(inverse, shift, limits, x, y, n):
     for a in range(3):
         u0 = inverse[a, 0] * (x - shift[0]) + inverse[a, 1] * (y - shift[1]) \
             - inverse[a, 2] * shift[2]
-        slope = inverse[a, 2]
-        if slope == 0.0:
-            if u0 < 0.0 or u0 > limits[a]:
-                return 0, -1
-            continue
-        z0 = -u0 / slope
-        z1 = (limits[a] - u0) / slope
-        z_lo = max(z_lo, min(z0, z1))
-        z_hi = min(z_hi, max(z0, z1))
+        z_lo, z_hi = _within(u0, inverse[a, 2], limits[a], z_lo, z_hi)
     if z_lo > z_hi:
         return 0, -1
     return max(0, int(math.floor(z_lo)) - 1), min(n - 1, int(math.ceil(z_hi)) + 1)
 
 
-@jit(inline="always")
+@jit
 def _over_lit(value, fraction, gx, gy, gz, tstart, tinv, alpha_tab, emit_tab, lit, ramp_x,
               ramp_y, buf, y, x):
     """:func:`_over` for a sample classified by its gradient ``g`` too (shading, gradient
@@ -311,14 +315,7 @@ def composite_slices(vol, front_to_back, inverse2, shift, limits, tstart, tinv, 
             for a in range(2):
                 u0 = (inverse2[a, 0] * (x - shift[0]) + inverse2[a, 1] * (y - shift[1]))
                 slope = -(inverse2[a, 0] * shift[2] + inverse2[a, 1] * shift[3])
-                if slope == 0.0:
-                    if u0 < 0.0 or u0 > limits[a]:
-                        w_lo, w_hi = 1.0, 0.0
-                    continue
-                w0 = -u0 / slope
-                w1 = (limits[a] - u0) / slope
-                w_lo = max(w_lo, min(w0, w1))
-                w_hi = min(w_hi, max(w0, w1))
+                w_lo, w_hi = _within(u0, slope, limits[a], w_lo, w_hi)
             if w_lo > w_hi:
                 w_first[x], w_last[x] = 0, -1
             else:
@@ -347,7 +344,7 @@ def composite_slices(vol, front_to_back, inverse2, shift, limits, tstart, tinv, 
         counts[y] = done
 
 
-@jit(inline="always")
+@jit
 def _slice_sum(slices, k, rows, i0, ntaps, wi, wj):
     """Slice ``k`` at taps ``i0 ..`` of rows ``rows``, weighted ``wi`` along and ``wj`` across
     the rows; columns clamped to the slice only near its ends."""
