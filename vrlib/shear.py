@@ -196,7 +196,8 @@ def _passes(volume, view, plan, filt, count, dtype, transfer):
             np.transpose(data, order), v1, plan.a, plan.b, plan.c, plan.t0,
             np.zeros((nw, nv), np.int64), np.full((nw, nv), nu - 1, np.int64), filt)
         count["pass1"] += done
-        lo, hi = _filled(first1, last1, view.width)  # pass 2 lines (w, X) run along v
+        if channel == 0:  # where data lies depends on the geometry only: the same for all
+            lo, hi = _filled(first1, last1, view.width)  # pass 2 lines (w, X) run along v
         done, first2, last2 = _run_pass(
             v1.transpose(0, 2, 1), v2[channel].transpose(0, 2, 1), plan.e, plan.d, plan.f,
             plan.t1, lo, hi, filt)
