@@ -8,6 +8,7 @@ import math
 
 import numpy as np
 
+import vrlib
 from vrlib.reference import _clip_to_box
 
 
@@ -33,6 +34,39 @@ def exact_blob_image(field, view, scale):
     o, d = view.rays()
     t0, t1 = _clip_to_box(o, d, field.bounds[:, 0], field.bounds[:, 1])
     return 1.0 - np.exp(-scale * field.line_integral(o, d, t0, t1))
+
+
+def interpolation_matrix(filt, n):
+    """The n x n matrix taking a line's coefficients to its samples, ``f_m = sum_k c_k
+    k(m - k)``, the coefficients extended half-sample symmetrically (``c_{-1-j} = c_j``): the
+    prefilter's boundary rule written out as a linear system."""
+    a = np.zeros((n, n))
+    for m in range(n):
+        for k in range(m - math.ceil(filt.radius), m + math.ceil(filt.radius) + 1):
+            j = k
+            while not 0 <= j < n:  # reflect until inside (short lines reflect twice)
+                j = -1 - j if j < 0 else 2 * n - 1 - j
+            a[m, j] += float(filt(float(m - k)))
+    return a
+
+
+def prefilter_naive(data, filt, axes):
+    """Coefficients of ``data`` along array ``axes`` by solving each line's interpolation
+    system (:func:`interpolation_matrix`); the data itself for filters without a prefilter."""
+    data = np.asarray(data, dtype=np.float64)
+    if not filt.prefiltered:
+        return data
+    for axis in axes:
+        data = np.apply_along_axis(
+            lambda f: np.linalg.solve(interpolation_matrix(filt, len(f)), f), axis, data)
+    return data
+
+
+def coefficient_volume_naive(volume, filt):
+    """The volume a prefiltered filter's kernel reconstructs from: its 3-D coefficients."""
+    if not filt.prefiltered:
+        return volume
+    return vrlib.Volume(prefilter_naive(volume.data, filt, (0, 1, 2)), volume.extent)
 
 
 def reconstruct_naive(volume, filt, points_index, *, gradient=False):
@@ -66,6 +100,7 @@ def raycast_naive(volume, view, filt, transfer, step):
     """Ray casting by the book: samples at t = (k + 1/2) ds inside the volume box, opacity
     1 - exp(-density ds) (eq 1.4), colour E alpha (eq 1.9), composited front to back."""
     ds = step * float(volume.spacing.min())
+    volume = coefficient_volume_naive(volume, filt)
     origins, directions = view.rays()
     lo, hi = volume.extent[:, 0], volume.extent[:, 1]
     image = np.zeros(view.shape + (4,))
@@ -134,6 +169,7 @@ def splat_naive(volume, view, filt, transfer, mode):
     from vrlib.footprint import footprint
     from vrlib.view import principal_axis
 
+    volume = coefficient_volume_naive(volume, filt)
     axis, ascending = principal_axis(view, volume)
     spacing = volume.spacing
     radial = filt.name == "gaussian" and np.ptp(spacing) == 0.0
@@ -200,12 +236,14 @@ def shear_pass_naive(src, valid, out_shape, c0, c1, c2, offset, filt):
             if where.size == 0:
                 continue
             lo, hi = where[0], where[-1]
+            line = src[s, r].copy()
+            line[lo:hi + 1] = prefilter_naive(line[lo:hi + 1], filt, (0,))
             for q in range(out_shape[2]):
                 pos = (q - offset - c1 * r - c2 * s) / c0
                 if not lo - filt.radius <= pos <= hi + filt.radius:
                     continue
                 idx = math.floor(pos - filt.radius) + 1 + np.arange(taps)
-                out[s, r, q] = np.sum(filt(pos - idx) * src[s, r, np.clip(idx, lo, hi)])
+                out[s, r, q] = np.sum(filt(pos - idx) * line[np.clip(idx, lo, hi)])
                 computed[s, r, q] = True
     return out, computed
 
@@ -321,6 +359,7 @@ def shearwarp_naive(volume, view, filt, transfer):
     axes = [q_axis, p_axis, axis]
     slices = np.transpose(np.asarray(volume.data, float),
                           (2 - axis, 2 - p_axis, 2 - q_axis))
+    slices = prefilter_naive(slices, filt, (1, 2))  # in-slice coefficients
     n_k, n_j, n_i = slices.shape
     h = volume.spacing[axes]
     kf = 0 if ascending else n_k - 1
@@ -328,7 +367,8 @@ def shearwarp_naive(volume, view, filt, transfer):
     if transfer.needs_gradient:  # central differences (world units, x y z), in slice order
         field = np.asarray(volume.data, float)
         hx, hy, hz = volume.spacing
-        gradients = [np.transpose(g, (2 - axis, 2 - p_axis, 2 - q_axis)) for g in (
+        gradients = [prefilter_naive(np.transpose(g, (2 - axis, 2 - p_axis, 2 - q_axis)), filt,
+                                     (1, 2)) for g in (
             np.gradient(field, hx, axis=2), np.gradient(field, hy, axis=1),
             np.gradient(field, hz, axis=0))]
     eye = None if view.eye is None else (view.eye - volume.origin)[axes] / h

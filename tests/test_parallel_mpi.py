@@ -212,3 +212,6 @@ def test_bad_arguments_name_the_parameter(tmp_path):
         mpi.render_object(comm, field, view, shape=9, root=1)
     with pytest.raises(TypeError, match="view must be a vrlib.View"):
         mpi.render_image(comm, field, "front", shape=9)
+    for render in (mpi.render_object, mpi.render_image):
+        with pytest.raises(ValueError, match="'omoms' reconstructs prefiltered coefficients"):
+            render(comm, field, view, shape=9, filter="omoms")

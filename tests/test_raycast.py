@@ -14,7 +14,7 @@ from vrlib.raycast import cast_rays
 from vrlib.value_bounds import reconstructed_range
 
 FILTERS = ["box", "trilinear", "catmull-rom", "bspline", "mitchell", "gaussian",
-           ("mitchell-netravali", 0.2, 0.6), ("gaussian", 0.5, 1.5)]
+           ("mitchell-netravali", 0.2, 0.6), ("gaussian", 0.5, 1.5), "omoms"]
 TABLE = LookupTransfer([0.0, 3.0, 1.0, 5.0], [[1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 1]])
 
 

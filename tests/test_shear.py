@@ -17,7 +17,7 @@ from vrlib import Glow, LookupTransfer, View, Volume, metrics, render
 from vrlib.shear import plan_shear
 
 TABLE = LookupTransfer([0.0, 3.0, 1.0, 5.0], [[1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 1]])
-FILTERS = ["box", "trilinear", "catmull-rom", "gaussian"]
+FILTERS = ["box", "trilinear", "catmull-rom", "gaussian", "omoms"]
 METHODS = ["shear3", "shear2", "shearwarp"]
 
 

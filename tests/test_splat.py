@@ -94,6 +94,21 @@ def test_kernel_matches_naive_twin(projection, filt, transfer, mode):
     assert fast.alpha.max() > 0.1
 
 
+@pytest.mark.parametrize("projection", ["orthographic", "perspective"])
+def test_prefiltered_sheets_match_naive_twin(projection):
+    """A prefiltered filter splats the volume's coefficients (the twin solves for them) with
+    its kernel's footprint; direct mode, which classifies voxels, refuses it."""
+    vol = small_volume()
+    view = View.orbit(azimuth=33, elevation=-21, size=(7, 9), projection=projection)
+    fast = render(vol, view, method="splat", filter="omoms", transfer=TABLE,
+                  early_termination=1.0)
+    slow = splat_naive(vol, view, vrlib.make_filter("omoms"), TABLE, "sheet")
+    np.testing.assert_allclose(fast.rgba, slow, atol=1e-6)
+    assert fast.alpha.max() > 0.1
+    with pytest.raises(ValueError, match="direct splatting classifies each voxel"):
+        render(vol, view, method="splat", filter="omoms", mode="direct")
+
+
 @pytest.mark.parametrize("mode", ["sheet", "direct"])
 def test_bit_identical_for_one_and_two_threads(mode):
     if numba.config.NUMBA_NUM_THREADS < 2:

@@ -17,10 +17,11 @@ Conventions, stated once for the whole package:
 The public API is the list in ``__all__``.
 """
 
-from vrlib import bounds, compositing, cost, filters, metrics
+from vrlib import bounds, compositing, cost, filters, metrics, prefilter
 from vrlib.classified import ClassifiedVolume, classify
 from vrlib.filters import FILTERS, make_filter
 from vrlib.image import Image, RenderStats
+from vrlib.reconstruction import reconstruct
 from vrlib.reference import render_reference
 from vrlib.render import METHODS, reference_image, render
 from vrlib.transfer import Glow, GradientOpacity, LookupTransfer, Phong, TransferFunction
@@ -32,6 +33,7 @@ __version__ = "0.1.0"
 __all__ = [
     "render",
     "render_reference",
+    "reconstruct",
     "reference_image",
     "METHODS",
     "classify",
@@ -48,6 +50,7 @@ __all__ = [
     "make_filter",
     "FILTERS",
     "filters",
+    "prefilter",
     "compositing",
     "metrics",
     "bounds",

@@ -12,6 +12,10 @@ interface:
 * ``f.frequency_response(omega)``: the analytic Fourier transform, ``omega`` in radians per
   sample (the Nyquist frequency is pi);
 * ``f.interpolating`` and ``f.partition_of_unity``: what theory says of the kernel;
+* ``f.poles``: the prefilter's poles for a *prefiltered* filter (generalized interpolation:
+  the kernel reconstructs from coefficients that :mod:`vrlib.prefilter` computes from the
+  samples, so that the reconstruction passes through them), empty for the others;
+  ``f.effective_response(omega)``, the response of the reconstruction from the samples;
 * ``f.code``: ``(kind, p0, p1, p2)`` scalars that the numba kernels evaluate with
   :func:`vrlib._kernels.filters.weight`.
 
@@ -41,6 +45,8 @@ __all__ = [
     "Pyramid",
     "Gaussian",
     "MitchellNetravali",
+    "CardinalBSpline",
+    "OMOMS",
     "FILTERS",
     "STANDARD",
     "MAX_RADIUS",
@@ -60,6 +66,9 @@ class Filter:
     radius: float
     interpolating: bool
     partition_of_unity: bool
+    #: Poles of the prefilter (:mod:`vrlib.prefilter`) whose coefficients the kernel
+    #: reconstructs from; empty for a filter applied to the samples themselves.
+    poles: tuple = ()
 
     @property
     def code(self):
@@ -108,6 +117,37 @@ class Filter:
     def frequency_response(self, omega):
         """Fourier transform ``K(omega) = int k(x) exp(-i omega x) dx`` (real: ``k`` is even)."""
         raise NotImplementedError
+
+    @property
+    def prefiltered(self):
+        """True when the kernel reconstructs prefiltered coefficients, not the samples."""
+        return bool(self.poles)
+
+    @property
+    def interpolates_samples(self):
+        """True when the reconstruction passes through every sample: an interpolating kernel,
+        or any kernel on its prefiltered coefficients."""
+        return self.interpolating or self.prefiltered
+
+    def effective_response(self, omega):
+        """Frequency response of the reconstruction from the samples: the kernel's, divided
+        for a prefiltered filter by the sampled kernel's ``sum_n k(n) cos(n omega)`` (the
+        prefilter is its inverse; Thevenaz, Blu and Unser 2000, eq 12).
+
+        Examples
+        --------
+        >>> f = make_filter("cardinal-bspline")
+        >>> f.effective_response(np.array([0.0, np.pi])).round(4).tolist()  # Nyquist: 48 / pi^4
+        [1.0, 0.4928]
+        """
+        response = self.frequency_response(omega)
+        if not self.prefiltered:
+            return response
+        omega = np.asarray(omega, dtype=np.float64)
+        sampled = np.full(omega.shape, float(self(0.0)))
+        for n in range(1, math.ceil(self.radius)):
+            sampled += 2.0 * float(self(float(n))) * np.cos(n * omega)
+        return response / sampled
 
     def _key(self):
         return (type(self).__name__, self.name, tuple(self.params.values()))
@@ -280,7 +320,7 @@ class MitchellNetravali(_Piecewise):
         self.name = name
         # The two cubic pieces (the kernels' one definition, run as plain Python: building a
         # filter compiles nothing), divided by 6, ascending powers.
-        near, far = _cubic_coefficients(self.B, self.C)
+        near, far = _cubic_coefficients(self.B, self.C, 0.0)
         self.pieces = (
             (0.0, 1.0, tuple(v / 6 for v in near)),
             (1.0, 2.0, tuple(v / 6 for v in far)),
@@ -374,6 +414,80 @@ class Gaussian(Filter):
         return value * s * math.sqrt(2.0 * math.pi) / self._norm
 
 
+class _Prefiltered:
+    """A radius-2 kernel on prefiltered coefficients: its prefilter's one pole is derived from
+    the kernel. The sampled kernel ``k(1) z + k(0) + k(1) / z`` vanishes at ``z = p`` and
+    ``1 / p``, the roots of ``k(1) p^2 + k(0) p + k(1) = 0``; the prefilter ``1 / (sampled
+    kernel)`` is the causal and anticausal recursion on ``p``, the root inside the unit
+    circle."""
+
+    @property
+    def poles(self):
+        """The prefilter's pole: the root of ``k(1) p^2 + k(0) p + k(1) = 0`` in (-1, 0)."""
+        k0, k1 = float(self(0.0)), float(self(1.0))
+        return ((math.sqrt(k0 * k0 - 4.0 * k1 * k1) - k0) / (2.0 * k1),)
+
+    def __repr__(self):
+        return f"make_filter({self.name!r})"
+
+
+class CardinalBSpline(_Prefiltered, MitchellNetravali):
+    """The cubic B-spline on prefiltered coefficients: the interpolating cubic spline
+    (Unser 1999; Thevenaz, Blu and Unser 2000), radius 2, prefilter pole ``sqrt(3) - 2``.
+
+    Its kernel is the cubic B-spline (``B, C = 1, 0``), not interpolating by itself; the
+    reconstruction from the coefficients is (``interpolates_samples``).
+
+    Examples
+    --------
+    >>> f = CardinalBSpline()
+    >>> round(f.poles[0], 12) == round(math.sqrt(3.0) - 2.0, 12), f.interpolates_samples
+    (True, True)
+    >>> (f([0.0, 1.0, 2.0]) * 6).round(12).tolist()
+    [4.0, 1.0, 0.0]
+    """
+
+    def __init__(self):
+        super().__init__(1.0, 0.0, name="cardinal-bspline")
+
+    @property
+    def params(self):
+        return {}
+
+
+class OMOMS(_Prefiltered, _Piecewise):
+    """The cubic O-MOMS kernel on prefiltered coefficients (Blu, Thevenaz and Unser 2001):
+    ``B3(x) + B3''(x) / 42``, the cubic of support 4 with the smallest asymptotic
+    approximation error; radius 2, prefilter pole ``(sqrt(105) - 13) / 8``.
+
+    Its pieces on ``|x| < 1`` and ``1 <= |x| < 2`` are ``|x|^3 / 2 - x^2 + |x| / 14 + 13 / 21``
+    and ``-|x|^3 / 6 + x^2 - 85 |x| / 42 + 29 / 21``; it is continuous, with a kink at 0.
+
+    Examples
+    --------
+    >>> f = OMOMS()
+    >>> (f([0.0, 1.0, 2.0]) * 21).round(12).tolist()
+    [13.0, 4.0, 0.0]
+    >>> round(f.poles[0], 12) == round((math.sqrt(105.0) - 13.0) / 8.0, 12)
+    True
+    """
+
+    name = "omoms"
+    radius = 2.0
+    interpolating = False
+    partition_of_unity = True
+    _D = 1.0 / 42.0
+
+    def __init__(self):
+        near, far = _cubic_coefficients(1.0, 0.0, self._D)
+        self.pieces = ((0.0, 1.0, tuple(v / 6 for v in near)),
+                       (1.0, 2.0, tuple(v / 6 for v in far)))
+
+    @property
+    def code(self):
+        return (_k.CUBIC, 1.0, 0.0, self._D)
+
+
 def _catmull_rom():
     return MitchellNetravali(0.0, 0.5, name="catmull-rom")
 
@@ -395,6 +509,8 @@ FILTERS = {
     "catmull-rom": _catmull_rom,
     "mitchell": _mitchell,
     "bspline": _bspline,
+    "cardinal-bspline": CardinalBSpline,
+    "omoms": OMOMS,
     "mitchell-netravali": MitchellNetravali,
 }
 

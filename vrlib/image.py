@@ -38,12 +38,16 @@ class RenderStats:
         Reconstructed points composited into the image, the cost model's unit
         (:mod:`vrlib.cost`); ``samples`` unless the renderer says otherwise (three- and
         two-pass shearing: the composited samples, not the resampled ones).
+    prefilter : dict or None
+        Prefiltered filters (:mod:`vrlib.prefilter`): the prefilter's ``seconds``,
+        ``operations`` and ``samples`` filtered in this render (included in the totals above;
+        0, and ``cached`` True, when every coefficient it needed was kept from before).
 
     Examples
     --------
     >>> RenderStats(samples=10, seconds=0.5).as_dict()     # doctest: +NORMALIZE_WHITESPACE
     {'samples': 10, 'operations': 0, 'bytes': 0, 'seconds': 0.5, 'voxels': 0, 'passes': None,
-     'points': 10}
+     'points': 10, 'prefilter': None}
     """
 
     samples: int = 0
@@ -53,6 +57,7 @@ class RenderStats:
     voxels: int = 0
     passes: dict | None = None
     points: int | None = None
+    prefilter: dict | None = None
 
     def __post_init__(self):
         if self.points is None:

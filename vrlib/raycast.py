@@ -19,6 +19,7 @@ from vrlib._kernels import raycast as _kernel
 from vrlib._kernels.filters import TENT
 from vrlib._scheduling import balanced_order
 from vrlib.image import Image, RenderStats
+from vrlib.prefilter import Tally, prepared
 from vrlib.skipping import BLOCK, coarsen, empty_blocks, footprint_mask, visible_box
 from vrlib.value_bounds import reconstructed_range
 
@@ -53,6 +54,9 @@ def operations_per_sample(filt, *, shading=False):
 def render_raycast(volume, view, *, filt, transfer, step, early_termination,
                    empty_space_skipping):
     """Ray-cast ``volume`` (arguments already validated by :func:`vrlib.render`)."""
+    start = time.perf_counter()
+    tally = Tally()
+    volume = prepared(volume, filt, tally)  # prefiltered filters: the 3-D coefficients
     extent = volume.extent
     box_lo, box_hi = extent[:, 0].copy(), extent[:, 1].copy()
     skip = None
@@ -61,7 +65,6 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
         if empty.any():  # with nothing to skip, checking would only cost time
             box_lo, box_hi = visible_box(volume, empty, BLOCK, box_lo, box_hi)
             skip = (empty, coarsen(empty), BLOCK, footprint_mask(view, volume, empty, BLOCK))
-    start = time.perf_counter()
     rgba, taken = cast_rays(
         volume.data, offset=(0, 0, 0), global_shape=volume.shape, origin=volume.origin,
         spacing=volume.spacing, box=(box_lo, box_hi), view=view, filt=filt, transfer=transfer,
@@ -74,7 +77,7 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
         bytes=int(volume.data.nbytes + rgba.nbytes),
         seconds=time.perf_counter() - start,
     )
-    return Image(rgba, stats)
+    return Image(rgba, tally.finish(stats, filt))
 
 
 def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, transfer, ds,

@@ -53,7 +53,10 @@ def render(volume, view, *, method="raycast", filter="trilinear", transfer=None,
     method : {"raycast", "splat", "shear3", "shear2", "shearwarp"}
         The rendering method (see :data:`METHODS`).
     filter : str, tuple or Filter, default "trilinear"
-        Reconstruction filter, by name or built with :func:`vrlib.make_filter`.
+        Reconstruction filter, by name or built with :func:`vrlib.make_filter`. A prefiltered
+        filter (``"cardinal-bspline"``, ``"omoms"``) reconstructs spline coefficients with its
+        kernel, in every method (:mod:`vrlib.prefilter` says which axes each prefilters; the
+        volume's coefficients are kept with it); ``stats.prefilter`` says what it cost.
     transfer : TransferFunction, default ``Glow(1.0)``
     step : float, default 0.5
         Sample spacing along each ray, in voxels (of the smallest spacing); > 0. Opacity is

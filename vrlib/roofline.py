@@ -132,7 +132,7 @@ def measure(*, threads=None, repeats=5, elements=1 << 24, rays=1 << 16):
     ['bandwidth', 'footprint_catmull-rom', 'footprint_trilinear', 'resample_catmull-rom',
      'resample_trilinear', 'slice_catmull-rom', 'slice_trilinear', 'threads',
      'tricubic_float32', 'tricubic_float64', 'trilinear_float32', 'trilinear_float64']
-    >>> bool(limits["trilinear_float32"] > limits["tricubic_float32"] > 0)
+    >>> all(v > 0 for v in limits.values())   # rates only: comparing them is a benchmark's job
     True
     """
     repeats = validate.positive_int("repeats", repeats)

@@ -32,8 +32,9 @@ import numpy as np
 
 from vrlib import validate
 from vrlib._kernels import shear as _kernel
-from vrlib.gradients import gradient_volumes, kernel_lighting, no_gradients
+from vrlib.gradients import kernel_lighting, no_gradients
 from vrlib.image import Image, RenderStats
+from vrlib.prefilter import Tally, filter_lines, prepared, prepared_gradients
 from vrlib.value_bounds import reconstructed_range
 
 __all__ = ["render_shear3", "render_shear2", "ShearPlan", "plan_shear", "INTERMEDIATES"]
@@ -170,19 +171,21 @@ def _run_pass(src, out, c0, c1, c2, offset, lo, hi, filt):
 INTERMEDIATES = {"float32": np.float32, "float64": np.float64}
 
 
-def _passes(volume, view, plan, filt, count, dtype, transfer):
+def _passes(volume, view, plan, filt, count, dtype, transfer, tally, third_pass):
     """Passes 1 and 2; returns ``V2[w, Y, X]``, the gradient's components after the same passes
     (``[3, w, Y, X]``, when ``transfer`` needs them: :mod:`vrlib.gradients`; else a
     placeholder, :func:`vrlib.gradients.no_gradients`) and the computed output ranges of pass 2.
 
     Each pass computes only outputs the volume reaches: a line of pass 2 holds data where pass 1
-    computed it, and so on.
+    computed it, and so on. A prefiltered filter prefilters each pass's lines along the pass's
+    axis first (:mod:`vrlib.prefilter`): pass 1's input along ``u`` (the volume's, cached),
+    pass 2's along ``v`` and, when ``third_pass``, pass 3's along ``w`` (counted in ``tally``).
     """
     u, v, w = plan.order
     order = (2 - w, 2 - v, 2 - u)  # [w, v, u]
-    channels = [volume.data]
+    channels = [prepared(volume, filt, tally, axes=(u,)).data]
     if transfer.needs_gradient:
-        channels += list(gradient_volumes(volume))
+        channels += list(prepared_gradients(volume, filt, tally, axes=(u,)))
     nw, nv, nu = np.transpose(volume.data, order).shape
     # V2[w, Y, X] is stored as [Y, w, X]: the samples one image row needs lie together, for
     # the last pass (shear3) or the compositing (shear2), which take an image row at a time.
@@ -198,10 +201,15 @@ def _passes(volume, view, plan, filt, count, dtype, transfer):
         count["pass1"] += done
         if channel == 0:  # where data lies depends on the geometry only: the same for all
             lo, hi = _filled(first1, last1, view.width)  # pass 2 lines (w, X) run along v
+        _prefilter_lines(v1, lo, hi, filt, tally)  # V1[w, v, X]: lines along v
         done, first2, last2 = _run_pass(
             v1.transpose(0, 2, 1), v2[channel].transpose(0, 2, 1), plan.e, plan.d, plan.f,
             plan.t1, lo, hi, filt)
         count["pass2"] += done
+        if third_pass and filt.prefiltered:  # V2 stored [Y, w, X]: pass 3's lines along w
+            lo3, hi3 = _filled(first2.transpose(1, 0), last2.transpose(1, 0), view.height)
+            _prefilter_lines(stored[channel], np.ascontiguousarray(lo3.T),
+                             np.ascontiguousarray(hi3.T), filt, tally)
     count["buffers"] = v1.nbytes + stored.nbytes
     grads = no_gradients(dtype)
     if len(channels) > 1:
@@ -210,13 +218,24 @@ def _passes(volume, view, plan, filt, count, dtype, transfer):
     return v2[0], grads, first2, last2
 
 
-def _first_passes(volume, view, filt, step, dtype, transfer):
+def _prefilter_lines(lines, lo, hi, filt, tally):
+    """Prefilter an intermediate volume's lines ``lines[s, k, r]`` along ``k`` on their data
+    ranges, in place, for a prefiltered filter (subnormal results flushed to zero)."""
+    if not filt.prefiltered:
+        return
+    start = time.perf_counter()
+    filter_lines(lines, lo, hi, filt.poles, tiny=float(np.finfo(lines.dtype).tiny))
+    tally.add(time.perf_counter() - start, np.maximum(hi - lo + 1, 0).sum(), len(filt.poles))
+
+
+def _first_passes(volume, view, filt, step, dtype, transfer, tally, third_pass):
     """What both methods do first: the ray step in world units, the plan, and passes 1 and 2
     (:func:`_passes`) with their counts."""
     ds = step * float(volume.spacing.min())
     plan = plan_shear(volume, view, ds)
     count = {}
-    return ds, plan, count, _passes(volume, view, plan, filt, count, dtype, transfer)
+    return ds, plan, count, _passes(volume, view, plan, filt, count, dtype, transfer, tally,
+                                    third_pass)
 
 
 def _stats(volume, taps, count, composited, seconds, largest):
@@ -258,11 +277,12 @@ def render_shear3(volume, view, *, filt, transfer, step, early_termination,
     _check(view)
     dtype = _intermediate(intermediate, volume)
     start = time.perf_counter()
+    tally = Tally()
     ds, plan, count, (v2, grads, first2, last2) = _first_passes(volume, view, filt, step, dtype,
-                                                                 transfer)
+                                                                 transfer, tally, True)
     # Pass 3 runs along the rays: fused with compositing, no third volume is stored.
     lo, hi = _filled(first2.transpose(1, 0), last2.transpose(1, 0), view.height)  # [X, Y]
-    tables = transfer.segment_table(ds, *reconstructed_range(volume, filt))
+    tables = transfer.segment_table(ds, *reconstructed_range(volume, filt, cardinal=True))
     out = np.zeros(view.shape + (4,))
     resampled = np.zeros(view.height, np.int64)
     counts = np.zeros(view.height, np.int64)
@@ -278,7 +298,7 @@ def render_shear3(volume, view, *, filt, transfer, step, early_termination,
     del v2
     stats = _stats(volume, filt.taps, count, int(counts.sum()), time.perf_counter() - start,
                    largest)
-    return Image(np.clip(out, 0.0, 1.0), stats)
+    return Image(np.clip(out, 0.0, 1.0), tally.finish(stats, filt))
 
 
 def render_shear2(volume, view, *, filt, transfer, step, early_termination,
@@ -289,9 +309,11 @@ def render_shear2(volume, view, *, filt, transfer, step, early_termination,
     _check(view)
     dtype = _intermediate(intermediate, volume)
     start = time.perf_counter()
-    ds, plan, count, (v2, grads, _, _) = _first_passes(volume, view, filt, step, dtype, transfer)
+    tally = Tally()
+    ds, plan, count, (v2, grads, _, _) = _first_passes(volume, view, filt, step, dtype, transfer,
+                                                       tally, False)
     length = abs(plan.i) * ds  # world distance between slices along a ray
-    tables = transfer.segment_table(length, *reconstructed_range(volume, filt))
+    tables = transfer.segment_table(length, *reconstructed_range(volume, filt, cardinal=True))
     m = plan.matrix
     inverse2 = np.linalg.inv(np.array([[m[0, 0], m[0, 1]], [m[1, 0], m[1, 1]]]))
     shift = np.array([plan.shift[0], plan.shift[1], m[0, 2], m[1, 2]])
@@ -303,4 +325,4 @@ def render_shear2(volume, view, *, filt, transfer, step, early_termination,
                              counts)
     stats = _stats(volume, filt.taps, count, int(counts.sum()), time.perf_counter() - start,
                    count["buffers"])
-    return Image(np.clip(out, 0.0, 1.0), stats)
+    return Image(np.clip(out, 0.0, 1.0), tally.finish(stats, filt))

@@ -23,8 +23,9 @@ import numpy as np
 from vrlib import validate
 from vrlib._kernels import shear as _kernel
 from vrlib.arguments import refuse_gradients
-from vrlib.gradients import gradient_volumes, kernel_lighting, no_gradients
+from vrlib.gradients import kernel_lighting, no_gradients
 from vrlib.image import Image, RenderStats
+from vrlib.prefilter import Tally, prepared, prepared_gradients
 from vrlib.skipping import transparent_runs
 from vrlib.value_bounds import lattice_sums, reconstructed_range
 from vrlib.view import principal_axis
@@ -151,6 +152,11 @@ def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
     ntaps = filt.taps
     start = time.perf_counter()
     axis, ascending = principal_axis(view, volume)
+    tally = Tally()
+    # Prefiltered filters: coefficients in the slices' two axes (slices are not resampled
+    # across, so their own samples are composited).
+    in_slice = [a for a in range(3) if a != axis]
+    samples, volume = volume, prepared(volume, filt, tally, axes=in_slice)
     scale, di, dj, (oi, oj), (height, width), kf, rays = intermediate_plane(
         volume, view, axis, ascending)
     q_axis, p_axis = [a for a in range(3) if a != axis]
@@ -181,7 +187,7 @@ def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
     counts = np.zeros(height, np.int64)
     grads = no_gradients(np.float32)
     if transfer.needs_gradient:  # the gradient's components in slice order, like ``slices``
-        grads = gradient_volumes(volume).transpose(
+        grads = prepared_gradients(samples, filt, tally, in_slice).transpose(
             {2: (0, 1, 2, 3), 1: (0, 2, 1, 3), 0: (0, 3, 1, 2)}[axis])
     _kernel.shear_slices(slices, order, scale, di, dj, fraction, *filt.code, filt.radius,
                          ntaps, *tables, grads, *kernel_lighting(transfer, view.forward),
@@ -195,4 +201,4 @@ def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
     stats = RenderStats(samples=resampled, operations=resampled * (2 * ntaps**2 + 12)
                         + out.size * 8, bytes=int(volume.data.nbytes + inter.nbytes + out.nbytes),
                         seconds=time.perf_counter() - start, voxels=resampled)
-    return Image(out, stats, checked=False)  # the warp clipped it into [0, 1]
+    return Image(out, tally.finish(stats, filt), checked=False)  # the warp clipped it

@@ -28,6 +28,7 @@ from vrlib.arguments import refuse_gradients
 from vrlib.footprint import RADIAL, footprint
 from vrlib.gradients import SLAB, gradient_volumes
 from vrlib.image import Image, RenderStats
+from vrlib.prefilter import Tally, prepared
 from vrlib.value_bounds import reconstructed_range
 from vrlib.view import principal_axis
 
@@ -158,9 +159,16 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
         Footprint table entries per axis (:func:`vrlib.footprint.footprint`).
     """
     validate.choice("mode", mode, MODES)
+    if filt.prefiltered and mode == "direct":
+        raise ValueError(f"direct splatting classifies each voxel before reconstruction, and "
+                         f"the {filt.name!r} filter's voxels hold spline coefficients, not "
+                         f"values to classify; use mode='sheet' (reconstruct, then classify)")
     if mode == "sheet":
         refuse_gradients(transfer, "splatting with sheet buffers", "mode='direct' (each voxel "
                          "classified and shaded), method='raycast' or vrlib.classify")
+    start = time.perf_counter()
+    tally = Tally()
+    volume = prepared(volume, filt, tally)  # prefiltered filters: splat the coefficients
     axis, ascending = principal_axis(view, volume)
     extent = volume.extent
     if view.is_perspective and extent[axis, 0] <= view.eye[axis] <= extent[axis, 1]:
@@ -196,7 +204,6 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
     voxels = np.zeros(bands, np.int64)
     pixels = np.zeros(bands, np.int64)
     dummy1, dummy2 = np.zeros(2), np.zeros((2, 2))
-    start = time.perf_counter()
     _kernel.splat(
         volume.data, volume.origin, spacing, view.packed(), view.height, view.width, axis,
         slices, fp.kind, fp.extent, fp.extent_v or fp.extent,
@@ -220,4 +227,4 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
     # negative optical depth in direct mode; such pixels are clamped to transparent black.
     np.maximum(out, 0.0, out=out)
     np.minimum(out[..., 3], 1.0, out=out[..., 3])
-    return Image(out, stats)
+    return Image(out, tally.finish(stats, filt))

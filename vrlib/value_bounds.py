@@ -18,9 +18,27 @@ import numpy as np
 
 __all__ = ["lattice_sums", "value_bounds", "reconstructed_range"]
 
+_CARDINAL_REACH = 24  # samples a cardinal kernel is summed over each side (|p|^24 < 1e-11)
+
+
+def _weights(filt, offsets, cardinal):
+    """Weights at ``offsets`` in [0, 1] of every lattice point the reconstruction reaches:
+    the kernel's, or with ``cardinal`` a prefiltered filter's cardinal kernel
+    ``eta(x) = sum_j c_j k(x - j)``, ``c`` the prefiltered unit impulse."""
+    if not (cardinal and filt.prefiltered):
+        taps = np.arange(-math.ceil(filt.radius) - 1, math.ceil(filt.radius) + 2)
+        return filt(offsets[:, None] - taps[None, :])
+    from vrlib.prefilter import coefficients  # the prefilter needs the volume module
+
+    reach = _CARDINAL_REACH
+    impulse = coefficients(np.eye(1, 2 * reach + 1, reach)[0], filt.poles)
+    taps = np.arange(-reach - 3, reach + 4)
+    x = offsets[:, None] - taps[None, :]
+    return sum(c * filt(x - (j - reach)) for j, c in enumerate(impulse))
+
 
 @functools.lru_cache(maxsize=64)
-def lattice_sums(filt):
+def lattice_sums(filt, *, cardinal=False):
     """``(s_min, s_max, a_max)`` of a filter's 3-D weights over every position.
 
     ``s`` is the sum of the weights (1 for filters that form a partition of unity) and ``a``
@@ -31,6 +49,10 @@ def lattice_sums(filt):
     Parameters
     ----------
     filt : Filter
+    cardinal : bool, default False
+        For a prefiltered filter, the sums of the reconstruction from the samples (its
+        cardinal kernel, prefilter included) instead of its kernel's (which reconstructs from
+        coefficients).
 
     Examples
     --------
@@ -40,19 +62,22 @@ def lattice_sums(filt):
     (1.0, 1.0, 1.0)
     >>> lattice_sums(make_filter("catmull-rom"))[2] > 1.0     # negative lobes
     True
+    >>> [round(lattice_sums(make_filter("cardinal-bspline"), cardinal=c)[2] ** (1 / 3), 4)
+    ...  for c in (False, True)]                             # the interpolating spline rings
+    [1.0, 1.549]
     """
     offsets = np.linspace(0.0, 1.0, 4097)
-    taps = np.arange(-math.ceil(filt.radius) - 1, math.ceil(filt.radius) + 2)
-    w = filt(offsets[:, None] - taps[None, :])
+    w = _weights(filt, offsets, cardinal)
     s = w.sum(axis=1)
     a = np.abs(w).sum(axis=1)
     pad = 1.0 + 1e-9
     return float(s.min() ** 3 / pad), float(s.max() ** 3 * pad), float(a.max() ** 3 * pad)
 
 
-def value_bounds(low, high, filt):
-    """Bounds ``(lo, hi)`` on every value ``filt`` reconstructs from samples within
-    ``[low, high]`` (floats or arrays of them, elementwise).
+def value_bounds(low, high, filt, *, cardinal=False):
+    """Bounds ``(lo, hi)`` on every value ``filt``'s kernel reconstructs from values within
+    ``[low, high]`` (floats or arrays of them, elementwise); with ``cardinal``, what a
+    prefiltered filter reconstructs from samples within it (:func:`lattice_sums`).
 
     Examples
     --------
@@ -63,7 +88,7 @@ def value_bounds(low, high, filt):
     >>> bool(lo < 0.0 and hi > 1.0)                           # overshoot
     True
     """
-    s_min, s_max, a_max = lattice_sums(filt)
+    s_min, s_max, a_max = lattice_sums(filt, cardinal=cardinal)
     centre, half = 0.5 * (low + high), 0.5 * (high - low)
     lo = np.minimum(centre * s_min, centre * s_max) - a_max * half
     hi = np.maximum(centre * s_min, centre * s_max) + a_max * half
@@ -72,6 +97,7 @@ def value_bounds(low, high, filt):
     return lo, hi
 
 
-def reconstructed_range(volume, filt):
-    """Bounds on every value ``filt`` can reconstruct from ``volume``."""
-    return value_bounds(*volume.value_range, filt)
+def reconstructed_range(volume, filt, *, cardinal=False):
+    """Bounds on every value ``filt`` can reconstruct from ``volume`` (``cardinal``: from its
+    samples through the prefilter, :func:`value_bounds`)."""
+    return value_bounds(*volume.value_range, filt, cardinal=cardinal)

@@ -16,6 +16,8 @@ FILTERS = {
     "catmull-rom": "catmull-rom",
     "mitchell": "mitchell",
     "bspline": "bspline",
+    "cardinal-bspline": "cardinal-bspline",
+    "omoms": "omoms",
     "gaussian s=0.6": ("gaussian", 0.6, 2.0),
     "gaussian s=0.8": ("gaussian", 0.8, 2.0),
     "box": "box",

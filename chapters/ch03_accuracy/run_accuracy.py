@@ -69,12 +69,31 @@ def main():
         "summary_vanishing": summarise([r for r in records if r["field"] in VANISHING]),
         "boundary_rmse": {m: {f: float(np.median([r["rmse"] for r in records
                                                   if r["method"] == m and r["field"] == f]))
-                              for f in FIELDS} for m in METHODS}})
+                              for f in FIELDS} for m in METHODS},
+        "against_catmull_rom": against("catmull-rom", records),
+        "against_catmull_rom_vanishing": against(
+            "catmull-rom", [r for r in records if r["field"] in VANISHING])})
     with atomic_path(result_path(__file__, "images.npz")) as tmp:
         np.savez_compressed(tmp, **images)
 
 
 HIGHER_IS_BETTER = {"psnr", "ssim"}
+
+
+def against(baseline, records):
+    """Per method and filter: the median over cases of the rmse ratio to ``baseline``'s in the
+    same case, and the fraction of cases where the filter's rmse is lower."""
+    by_case = {(r["field"], r["n"], r["view"], r["method"], r["filter"]): r["rmse"]
+               for r in records}
+    out = {}
+    for method in METHODS:
+        out[method] = {}
+        for filt in FILTERS:
+            ratios = [rmse / by_case[key[:4] + (baseline,)] for key, rmse in by_case.items()
+                      if key[3] == method and key[4] == filt]
+            out[method][filt] = {"median_ratio": float(np.median(ratios)),
+                                 "lower": float(np.mean(np.array(ratios) < 1.0))}
+    return out
 
 
 def mean_ranks(records, label):

@@ -27,6 +27,12 @@ def main():
     write_csv(figure_path(__file__, "field_rmse.csv"), ["method"] + fields,
               [[m] + [f"{data['boundary_rmse'][m][f]:.2e}" for f in fields]
                for m in data["methods"]])
+    for name, key in [("against_catmull_rom.csv", "against_catmull_rom"),
+                      ("against_catmull_rom_vanishing.csv", "against_catmull_rom_vanishing")]:
+        table = data[key]
+        write_csv(figure_path(__file__, name), ["method"] + data["filters"],
+                  [[m] + [f"{table[m][f]['median_ratio']:.2f} ({table[m][f]['lower']:.0%})"
+                          for f in data["filters"]] for m in data["methods"]])
     overall = summary["overall"]
     rows = [[c, f"{overall['median_rmse'][c]:.2e}"]
             + [f"{overall['mean_rank'][m][c]:.1f}" for m in metrics]

@@ -22,8 +22,10 @@ def main():
                 *[cell(c["results"][m]) if m in c["results"] else "" for m in METHODS],
                 "holds" if c["passed"] else "fails"]
                for c in data["cases"] if set(c["results"]) == set(METHODS)])
-    write_csv(figure_path(__file__, "ringing.csv"), ["filter", "overshoot of a unit step"],
-              [[name, f"{r['max_error']:.4f}"] for c in data["cases"]
+    write_csv(figure_path(__file__, "ringing.csv"),
+              ["filter", "overshoot of a unit step", "bound (lattice sums)", "within"],
+              [[name, f"{r['max_error']:.4f}", f"{r['bound']:.4f}",
+                "yes" if r["passed"] else "no"] for c in data["cases"]
                if c["case"] == "step-edge ringing" for name, r in c["results"].items()])
     precision = read_json(result_path(__file__, "precision.json"))
     write_csv(figure_path(__file__, "storage.csv"),

@@ -10,7 +10,9 @@ kind          parameters
 ``BOX``       none: 1 on [-1/2, 1/2)
 ``TENT``      none: ``max(0, 1 - |x|)`` (the pyramid / trilinear filter)
 ``GAUSSIAN``  ``p0`` sigma, ``p1`` truncation radius, ``p2`` 1/normaliser
-``CUBIC``     ``p0`` B, ``p1`` C of the Mitchell-Netravali family
+``CUBIC``     ``p0`` B, ``p1`` C of the Mitchell-Netravali family, plus ``p2`` times the
+              cubic B-spline's second derivative (0 for the family itself; 1/42 with
+              ``B = 1, C = 0`` is the cubic O-MOMS)
 ============  ==========================================================
 """
 
@@ -26,13 +28,17 @@ MAX_TAPS = 8
 
 
 @jit
-def cubic_coefficients(b, c):
-    """The Mitchell-Netravali (B, C) kernel's two cubic pieces, times 6, in ascending powers of
-    ``|x|``: ``near`` on [0, 1) and ``far`` on [1, 2) (Mitchell and Netravali 1988). The one
-    definition of the family: :class:`vrlib.filters.MitchellNetravali` and every kernel read
-    it."""
-    near = (6.0 - 2.0 * b, 0.0, -18.0 + 12.0 * b + 6.0 * c, 12.0 - 9.0 * b - 6.0 * c)
-    far = (8.0 * b + 24.0 * c, -12.0 * b - 48.0 * c, 6.0 * b + 30.0 * c, -b - 6.0 * c)
+def cubic_coefficients(b, c, d):
+    """The two cubic pieces, times 6, in ascending powers of ``|x|`` (``near`` on [0, 1),
+    ``far`` on [1, 2)) of the Mitchell-Netravali (B, C) kernel (Mitchell and Netravali 1988)
+    plus ``d`` times the cubic B-spline's second derivative (``3|x| - 2`` near, ``2 - |x|``
+    far). The one definition of the piecewise cubics: :class:`vrlib.filters.MitchellNetravali`,
+    :class:`vrlib.filters.OMOMS` (``b, c, d = 1, 0, 1/42``; Blu, Thevenaz and Unser 2001) and
+    every kernel read it. With ``d = 0`` the pieces are the family's, to the bit."""
+    near = (6.0 - 2.0 * b - 12.0 * d, 18.0 * d, -18.0 + 12.0 * b + 6.0 * c,
+            12.0 - 9.0 * b - 6.0 * c)
+    far = (8.0 * b + 24.0 * c + 12.0 * d, -12.0 * b - 48.0 * c - 6.0 * d, 6.0 * b + 30.0 * c,
+           -b - 6.0 * c)
     return near, far
 
 
@@ -55,7 +61,7 @@ def weight(kind, p0, p1, p2, x):
         ax = abs(x)
         return 1.0 - ax if ax < 1.0 else 0.0
     if kind == CUBIC:
-        near, far = cubic_coefficients(p0, p1)
+        near, far = cubic_coefficients(p0, p1, p2)
         ax = abs(x)
         if ax < 1.0:
             return cubic_piece(near, ax) / 6.0
@@ -78,9 +84,9 @@ def derivative(kind, p0, p1, p2, x):
             return 0.0
         return -1.0 if x > 0.0 else 1.0
     if kind == CUBIC:
-        near, far = cubic_coefficients(p0, p1)
+        near, far = cubic_coefficients(p0, p1, p2)
         ax = abs(x)
-        sign = 1.0 if x >= 0.0 else -1.0
+        sign = 1.0 if x > 0.0 else (-1.0 if x < 0.0 else 0.0)  # 0 at O-MOMS's kink
         if ax < 1.0:
             return sign * cubic_piece_slope(near, ax) / 6.0
         if ax < 2.0:

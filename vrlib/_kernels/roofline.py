@@ -49,9 +49,9 @@ def sample_rays(brick, starts, direction, steps, cubic, b, c, out):
             tx, ty, tz = ux - ix, uy - iy, uz - iz
             base = iz * nxy + iy * nx + ix
             if cubic:
-                wx = cubic_weights(tx, b, c)
-                wy = cubic_weights(ty, b, c)
-                wz = cubic_weights(tz, b, c)
+                wx = cubic_weights(tx, b, c, 0.0)
+                wy = cubic_weights(ty, b, c, 0.0)
+                wz = cubic_weights(tz, b, c, 0.0)
                 first = base - nxy - nx - 1
                 for kz in range(4):
                     plane = 0.0
@@ -120,7 +120,7 @@ def resample_lines(lines, scale, shift, ntaps, b, c, out):
                 w[0] = 1.0 - t
                 w[1] = t
             else:
-                w[0], w[1], w[2], w[3] = cubic_weights(t, b, c)
+                w[0], w[1], w[2], w[3] = cubic_weights(t, b, c, 0.0)
                 first -= 1
             acc = 0.0
             for a in range(ntaps):

@@ -121,24 +121,25 @@ def lerp_corners(d000, d001, d010, d011, d100, d101, d110, d111, tx, ty, tz):
 
 
 @jit(inline="always")
-def cubic_weights(t, b, c):
-    """Mitchell-Netravali weights of the taps at offsets -1, 0, 1, 2 from a point at fraction
-    ``t`` in [0, 1) past tap 0 (distances 1 + t, t, 1 - t, 2 - t)."""
-    near, far = cubic_coefficients(b, c)
+def cubic_weights(t, b, c, d):
+    """Weights of a piecewise cubic (:func:`~vrlib._kernels.filters.cubic_coefficients`) for
+    the taps at offsets -1, 0, 1, 2 from a point at fraction ``t`` in [0, 1) past tap 0
+    (distances 1 + t, t, 1 - t, 2 - t)."""
+    near, far = cubic_coefficients(b, c, d)
     return (cubic_piece(far, 1.0 + t) / 6.0, cubic_piece(near, t) / 6.0,
             cubic_piece(near, 1.0 - t) / 6.0, cubic_piece(far, 2.0 - t) / 6.0)
 
 
 @jit(inline="always")
-def tricubic(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz, b, c):
-    """A Mitchell-Netravali (B, C) cubic's 4 x 4 x 4 taps; arguments as for
+def tricubic(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz, b, c, d):
+    """A piecewise cubic's 4 x 4 x 4 taps (:func:`cubic_weights`); arguments as for
     :func:`trilinear`."""
     ix = int(math.floor(ux))
     iy = int(math.floor(uy))
     iz = int(math.floor(uz))
     return four_taps(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ix - 1, iy - 1, iz - 1,
-                     cubic_weights(ux - ix, b, c), cubic_weights(uy - iy, b, c),
-                     cubic_weights(uz - iz, b, c))
+                     cubic_weights(ux - ix, b, c, d), cubic_weights(uy - iy, b, c, d),
+                     cubic_weights(uz - iz, b, c, d))
 
 
 @jit(inline="always")

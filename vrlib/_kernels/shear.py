@@ -36,7 +36,7 @@ def _line_taps(fkind, fp0, fp1, fp2, radius, ntaps, pos, w):
         return first
     if fkind == CUBIC:
         first = int(math.floor(pos)) - 1
-        w[0], w[1], w[2], w[3] = cubic_weights(pos - (first + 1), fp0, fp1)
+        w[0], w[1], w[2], w[3] = cubic_weights(pos - (first + 1), fp0, fp1, fp2)
         return first
     return filter_taps(fkind, fp0, fp1, fp2, radius, ntaps, pos, w)
 

@@ -102,6 +102,11 @@ def _root(root, size):
 def _check(view, filter, transfer, step, compositing=None, balance=None,
            bricks_per_rank=1):
     filt, transfer, step, _ = render_arguments(view, filter, transfer, step)
+    if filt.prefiltered:
+        raise ValueError(f"filter {filt.name!r} reconstructs prefiltered coefficients, and its "
+                         "prefilter is a recursion along whole lines of the volume, while each "
+                         "rank reads only its brick; use a filter applied to the samples "
+                         "(e.g. 'catmull-rom'), or vrlib.render on one machine")
     if compositing is not None:
         validate.choice("compositing", compositing, tuple(COMPOSITORS))
     if balance is not None:

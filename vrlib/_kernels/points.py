@@ -1,0 +1,39 @@
+"""Reconstruction at arbitrary points (:func:`vrlib.reconstruct`): the renderers' separable
+sum (:mod:`vrlib._kernels.sampling`), one point at a time, in parallel over blocks of points."""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import prange
+
+from vrlib._kernels._jit import parallel_jit
+from vrlib._kernels.filters import MAX_TAPS
+from vrlib._kernels.sampling import gradient, reconstruct
+
+#: Points per parallel task (each task holds its own scratch weights).
+BLOCK = 1024
+
+
+@parallel_jit
+def reconstruct_points(data, index, fkind, fp0, fp1, fp2, radius, ntaps, derivative, out):
+    """The field (``out[:, 0]``) or its index-space gradient (``out[:, 0:3]``, x y z) at index
+    positions ``index[n] = (ux, uy, uz)`` of ``data`` (the whole volume, taps clamped to it).
+    Every point is independent, so the result does not depend on the thread count."""
+    offset = np.zeros(3, dtype=np.int64)
+    gshape = np.array(data.shape, dtype=np.int64)
+    for block in prange((index.shape[0] + BLOCK - 1) // BLOCK):
+        wx = np.empty(MAX_TAPS)
+        wy = np.empty(MAX_TAPS)
+        wz = np.empty(MAX_TAPS)
+        dx = np.empty(MAX_TAPS)
+        dy = np.empty(MAX_TAPS)
+        dz = np.empty(MAX_TAPS)
+        for n in range(block * BLOCK, min(index.shape[0], (block + 1) * BLOCK)):
+            ux, uy, uz = index[n, 0], index[n, 1], index[n, 2]
+            if derivative:
+                out[n, 0], out[n, 1], out[n, 2] = gradient(
+                    data, offset, gshape, ux, uy, uz, fkind, fp0, fp1, fp2, radius, ntaps,
+                    wx, wy, wz, dx, dy, dz)
+            else:
+                out[n, 0] = reconstruct(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1, fp2,
+                                        radius, ntaps, wx, wy, wz)
