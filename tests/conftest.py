@@ -23,6 +23,27 @@ settings.register_profile("thorough", max_examples=500, deadline=None,
 settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "default"))
 
 
+#: A session of at least this many tests is a full run, worth compiling kernels beside.
+_FULL_RUN = 300
+
+
+def pytest_collection_finish(session):
+    """Compile the renderers' kernels in a second process while a full session runs
+    (``tests/warm_kernels.py`` says why); not when numba's JIT is off."""
+    if len(session.items) < _FULL_RUN or os.environ.get("NUMBA_DISABLE_JIT") == "1":
+        return
+    session.config.warm_kernels = subprocess.Popen(
+        [sys.executable, str(Path(__file__).parent / "warm_kernels.py")],
+        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+
+def pytest_sessionfinish(session):
+    warm = getattr(session.config, "warm_kernels", None)
+    if warm is not None and warm.poll() is None:
+        warm.terminate()
+        warm.wait(timeout=30)
+
+
 @pytest.fixture(scope="session")
 def mpi_kernels_compiled():
     """The renderers' kernels compiled once, by one rank, before any test starts many: eight

@@ -116,6 +116,8 @@ def test_every_method_counts_what_its_prefilter_costs():
         assert first.stats.prefilter["operations"] == (
             prefilter.OPERATIONS_PER_VOXEL * first.stats.prefilter["samples"]
             * (1 if method in ("shear3", "shear2") else (2 if method == "shearwarp" else 3)))
+        assert 0.0 < first.stats.prefilter["kept_seconds"] <= first.stats.prefilter["seconds"]
+        assert later.stats.prefilter["kept_seconds"] == 0.0
         per_frame = later.stats.prefilter["samples"]
         assert (per_frame > 0) == (method in ("shear3", "shear2")), method
         assert later.stats.prefilter["cached"] == (per_frame == 0)

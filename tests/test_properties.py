@@ -20,7 +20,7 @@ METHODS = list(vrlib.METHODS)
 FILTERS = list(vrlib.filters.STANDARD)
 #: Examples per rendering property: bounded in ``make test``, many more in ``make test-all``.
 RENDERS = settings(max_examples=300 if os.environ.get("HYPOTHESIS_PROFILE") == "thorough"
-                   else 20)
+                   else 12)
 
 
 @st.composite

@@ -41,7 +41,8 @@ class RenderStats:
     prefilter : dict or None
         Prefiltered filters (:mod:`vrlib.prefilter`): the prefilter's ``seconds``,
         ``operations`` and ``samples`` filtered in this render (included in the totals above;
-        0, and ``cached`` True, when every coefficient it needed was kept from before).
+        0, and ``cached`` True, when every coefficient it needed was kept from before), and
+        ``kept_seconds``, the part spent on coefficients kept with the volume.
 
     Examples
     --------

@@ -171,15 +171,19 @@ def coefficient_volume(volume, filt, axes=(0, 1, 2)):
 @dataclass
 class Tally:
     """What the prefilter cost in one render: ``seconds``, ``operations`` and ``samples``
-    filtered (0 when every coefficient was cached)."""
+    filtered (0 when every coefficient was cached), and ``kept_seconds``, the part spent on
+    coefficients kept with the volume for later frames."""
 
     seconds: float = 0.0
     operations: int = 0
     samples: int = 0
+    kept_seconds: float = 0.0
 
-    def add(self, seconds, samples, passes):
-        """Count ``samples`` filtered ``passes`` times (poles times axes) in ``seconds``."""
+    def add(self, seconds, samples, passes, *, kept=False):
+        """Count ``samples`` filtered ``passes`` times (poles times axes) in ``seconds``;
+        ``kept``: coefficients of the volume, kept with it."""
         self.seconds += seconds
+        self.kept_seconds += seconds if kept else 0.0
         self.samples += int(samples)
         self.operations += OPERATIONS_PER_VOXEL * int(samples) * int(passes)
 
@@ -187,8 +191,9 @@ class Tally:
         """Record the tally in a render's statistics (prefiltered filters only): the
         ``prefilter`` entry, its operations added to the total (its time is in it already)."""
         if filt.prefiltered:
-            stats.prefilter = {"seconds": self.seconds, "operations": self.operations,
-                               "samples": self.samples, "cached": self.samples == 0}
+            stats.prefilter = {"seconds": self.seconds, "kept_seconds": self.kept_seconds,
+                               "operations": self.operations, "samples": self.samples,
+                               "cached": self.samples == 0}
             stats.operations += self.operations
         return stats
 
@@ -201,7 +206,7 @@ def prepared(volume, filt, tally, axes=(0, 1, 2)):
         return volume
     made, seconds = coefficient_volume(volume, filt, axes)
     if seconds:
-        tally.add(seconds, volume.data.size, len(axes) * len(filt.poles))
+        tally.add(seconds, volume.data.size, len(axes) * len(filt.poles), kept=True)
     return made
 
 
@@ -222,7 +227,8 @@ def prepared_gradients(volume, filt, tally, axes):
             store[..., component] = coefficients(gradients[component], filt.poles,
                                                  axes=[2 - a for a in axes])
         store.flags.writeable = False
-        tally.add(time.perf_counter() - start, store.size, len(axes) * len(filt.poles))
+        tally.add(time.perf_counter() - start, store.size, len(axes) * len(filt.poles),
+                  kept=True)
         return np.moveaxis(store, -1, 0)
 
     return volume.cached(("gradient coefficients", filt.poles, axes), build, keep=4)

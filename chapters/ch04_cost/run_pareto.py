@@ -77,7 +77,7 @@ def main():
             fresh = vrlib.Volume(volume.data, volume.extent, copy=False)  # coefficients
             first = vrlib.render(fresh, view, method=method, filter=filt, transfer=transfer,
                                  **options)
-            once = first.stats.prefilter["seconds"] - image.stats.prefilter["seconds"]
+            once = first.stats.prefilter["kept_seconds"]
         rows.append({"renderer": "vrlib", "method": method, "filter": filt, "step": step,
                      "seconds": seconds + once, "frame_seconds": seconds,
                      "prefilter_seconds": once, "rmse": vrlib.metrics.rmse(image.alpha, ref)})

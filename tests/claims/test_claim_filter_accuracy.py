@@ -67,7 +67,8 @@ def test_prefiltered_cubics_have_a_lower_worst_case_error_than_catmull_rom(dims)
         cubic = bounds.feature_error("catmull-rom", ratio, dims=dims)
         spline, omoms = (bounds.feature_error(f, ratio, dims=dims) for f in PREFILTERED)
         assert omoms < spline < cubic, ratio
-        if dims == 1:
+    if dims == 1:  # the bound ranks them alike (three sizes: each bound takes a second)
+        for ratio in (0.75, 1.0, 2.0):
             assert max(bounds.fourier_bound(f, ratio) for f in PREFILTERED) < bounds.fourier_bound(
                 "catmull-rom", ratio)
 
