@@ -7,8 +7,7 @@ import numpy as np
 from numba import prange
 
 from vrlib._kernels._jit import parallel_jit
-from vrlib._kernels.filters import MAX_TAPS
-from vrlib._kernels.sampling import gradient, reconstruct
+from vrlib._kernels.sampling import gradient, reconstruct, tap_scratch
 
 #: Points per parallel task (each task holds its own scratch weights).
 BLOCK = 1024
@@ -22,12 +21,7 @@ def reconstruct_points(data, index, fkind, fp0, fp1, fp2, radius, ntaps, derivat
     offset = np.zeros(3, dtype=np.int64)
     gshape = np.array(data.shape, dtype=np.int64)
     for block in prange((index.shape[0] + BLOCK - 1) // BLOCK):
-        wx = np.empty(MAX_TAPS)
-        wy = np.empty(MAX_TAPS)
-        wz = np.empty(MAX_TAPS)
-        dx = np.empty(MAX_TAPS)
-        dy = np.empty(MAX_TAPS)
-        dz = np.empty(MAX_TAPS)
+        wx, wy, wz, dx, dy, dz = tap_scratch()
         for n in range(block * BLOCK, min(index.shape[0], (block + 1) * BLOCK)):
             ux, uy, uz = index[n, 0], index[n, 1], index[n, 2]
             if derivative:

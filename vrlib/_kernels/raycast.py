@@ -19,8 +19,15 @@ from numba import prange
 
 from vrlib._kernels._jit import jit, parallel_jit
 from vrlib._kernels.camera import pixel_ray, ray_box
-from vrlib._kernels.filters import CUBIC, MAX_TAPS, TENT
-from vrlib._kernels.sampling import gradient, reconstruct, separable4, tricubic, trilinear
+from vrlib._kernels.filters import CUBIC, TENT
+from vrlib._kernels.sampling import (
+    gradient,
+    reconstruct,
+    separable4,
+    tap_scratch,
+    tricubic,
+    trilinear,
+)
 from vrlib._kernels.shading import classify_by_gradient
 from vrlib._kernels.tables import lookup
 
@@ -115,12 +122,7 @@ def _tile(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, 
     plain = fkind == TENT and grey and not shade and not by_gradient and block == 0
     row0 = (tile_id // tiles_across) * tile_h
     col0 = (tile_id % tiles_across) * tile_w
-    wx = np.empty(MAX_TAPS)
-    wy = np.empty(MAX_TAPS)
-    wz = np.empty(MAX_TAPS)
-    dx = np.empty(MAX_TAPS)
-    dy = np.empty(MAX_TAPS)
-    dz = np.empty(MAX_TAPS)
+    wx, wy, wz, dx, dy, dz = tap_scratch()
     taken = 0
     for p in range(tile_h * tile_w):
         r = row0 + p // tile_w

@@ -11,9 +11,12 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from vrlib._kernels._jit import jit
 from vrlib._kernels.filters import (
     GAUSSIAN,
+    MAX_TAPS,
     cubic_coefficients,
     cubic_piece,
     derivative,
@@ -29,6 +32,14 @@ def clamp(i, n):
     if i > n - 1:
         return n - 1
     return i
+
+
+@jit(inline="always")
+def tap_scratch():
+    """Scratch for :func:`reconstruct` and :func:`gradient`: weights along x, y and z and
+    their derivatives, :data:`~vrlib._kernels.filters.MAX_TAPS` each."""
+    return (np.empty(MAX_TAPS), np.empty(MAX_TAPS), np.empty(MAX_TAPS), np.empty(MAX_TAPS),
+            np.empty(MAX_TAPS), np.empty(MAX_TAPS))
 
 
 @jit(inline="always")
