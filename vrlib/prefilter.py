@@ -160,6 +160,10 @@ def coefficient_volume(volume, filt, axes=(0, 1, 2)):
         start = time.perf_counter()
         c = coefficients(volume.data, filt.poles, axes=[2 - a for a in axes],
                          tiny=_tiny(volume))
+        if not np.isfinite(c).all():  # within a factor of a few of the largest float
+            raise ValueError(f"the {filt.name!r} prefilter overflows on samples this large "
+                             f"(largest magnitude {max(map(abs, volume.value_range)):.3g}); "
+                             "scale the volume's values down")
         made = Volume(c.astype(volume.dtype, copy=False), volume.extent, copy=False)
         spent.append(time.perf_counter() - start)
         return made

@@ -70,4 +70,4 @@ def filter_lines(a, lo, hi, poles, terms, tiny):
             filter_line(line, n, poles, terms)
             for k in range(n):
                 value = line[k]
-                a[s, first + k, r] = value if abs(value) >= tiny else 0.0
+                a[s, first + k, r] = 0.0 if abs(value) < tiny else value  # NaN stays NaN
