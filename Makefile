@@ -43,11 +43,9 @@ all: results report
 
 venv: $(INSTALLED)
 
-# --no-compile: Python compiles what is imported on first use; byte-compiling every installed
-# file up front took half the install's time.
 $(INSTALLED): pyproject.toml constraints.txt
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
-	$(PY) -m pip install --quiet --no-compile --disable-pip-version-check -c constraints.txt -e '.[all]'
+	$(PY) -m pip install --quiet --disable-pip-version-check -c constraints.txt -e '.[all]'
 	@touch $@
 
 results: $(RESULTS) $(VERDICTS)
