@@ -63,6 +63,14 @@ def test_readme_classified_example_runs(capsys):
     assert count == "12"
 
 
+def test_readme_reconstruction_example_prints_what_it_says(capsys):
+    """The point errors its comment quotes, in that order (the claim test's measurement)."""
+    exec(compile(blocks("python")[3], "README.md", "exec"), {})
+    printed = [line.split() for line in capsys.readouterr().out.strip().splitlines()]
+    assert [(name, float(value)) for name, value in printed] == [
+        ("catmull-rom", 0.0219), ("cardinal-bspline", 0.0132), ("omoms", 0.0103)]
+
+
 def test_readme_pictures_are_what_their_commands_make(tmp_path):
     import imageio.v3 as iio
 
