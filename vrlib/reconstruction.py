@@ -2,8 +2,9 @@
 
 The renderers' own separable sum (:mod:`vrlib._kernels.sampling`), with their boundary rule
 (the lattice extended by its border values; a prefiltered filter reconstructs the
-coefficients of :mod:`vrlib.prefilter`), exposed for filter studies: a value here is the value
-a renderer composites at the same point.
+coefficients of :mod:`vrlib.prefilter`), exposed for filter studies: a value here is what the
+ray caster reconstructs at a sample at the same point (to rounding: its unrolled paths sum the
+same taps in another order).
 """
 
 from __future__ import annotations
