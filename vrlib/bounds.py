@@ -28,6 +28,7 @@ import numpy as np
 
 from vrlib import validate
 from vrlib.filters import make_filter
+from vrlib.prefilter import coefficients
 
 __all__ = ["feature_error", "fourier_bound", "required_ratio", "error_samples"]
 
@@ -78,8 +79,6 @@ def error_samples(filt, ratio, *, offsets=_OFFSETS, per_sample=_PER_SAMPLE):
     lattice = np.arange(first.min(), first.max() + filt.taps)
     samples = np.exp(-0.5 * ((lattice - centres) / sigma) ** 2)
     if filt.prefiltered:  # the feature is below 1e-10 at the lattice's ends: no edge effect
-        from vrlib.prefilter import coefficients
-
         samples = coefficients(samples, filt.poles, axes=[1])
     r = np.zeros_like(f)
     for tap in range(filt.taps):

@@ -32,6 +32,7 @@ the lattice, so ``"pyramid"`` and ``"trilinear"`` name the same filter here.
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
@@ -421,7 +422,7 @@ class _Prefiltered:
     kernel)`` is the causal and anticausal recursion on ``p``, the root inside the unit
     circle."""
 
-    @property
+    @functools.cached_property
     def poles(self):
         """The prefilter's pole: the root of ``k(1) p^2 + k(0) p + k(1) = 0`` in (-1, 0)."""
         k0, k1 = float(self(0.0)), float(self(1.0))

@@ -107,14 +107,13 @@ def coefficients(samples, poles, *, axes=None, tiny=0.0):
         raise ValueError(f"samples must have 1 to 3 dimensions, got shape {c.shape}")
     shape = c.shape
     c = c.reshape((1,) * (3 - c.ndim) + shape)
-    poles, terms = _check_poles(poles)
+    _check_poles(poles)
     for axis in range(len(shape)) if axes is None else axes:
         axis = axis % len(shape) + 3 - len(shape)
-        # As [s, k, r] with the line axis in the middle (views, no copies).
+        # As [s, k, r] with the line axis in the middle (views, no copies), lines whole.
         lines = {0: c.transpose(1, 0, 2), 1: c, 2: c.reshape(-1, c.shape[2], 1)}[axis]
         lo = np.zeros((lines.shape[0], lines.shape[2]), np.int64)
-        hi = np.full_like(lo, lines.shape[1] - 1)
-        _kernel.filter_lines(lines, lo, hi, poles, terms, float(tiny))
+        filter_lines(lines, lo, lo + lines.shape[1] - 1, poles, tiny=tiny)
     return c.reshape(shape)
 
 

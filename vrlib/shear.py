@@ -174,7 +174,8 @@ INTERMEDIATES = {"float32": np.float32, "float64": np.float64}
 def _passes(volume, view, plan, filt, count, dtype, transfer, tally, third_pass):
     """Passes 1 and 2; returns ``V2[w, Y, X]``, the gradient's components after the same passes
     (``[3, w, Y, X]``, when ``transfer`` needs them: :mod:`vrlib.gradients`; else a
-    placeholder, :func:`vrlib.gradients.no_gradients`) and the computed output ranges of pass 2.
+    placeholder, :func:`vrlib.gradients.no_gradients`) and, when ``third_pass``, where pass 3's
+    lines (along ``w``, one per pixel) hold data: ``(lo, hi)``, each ``[Y, X]``.
 
     Each pass computes only outputs the volume reaches: a line of pass 2 holds data where pass 1
     computed it, and so on. A prefiltered filter prefilters each pass's lines along the pass's
@@ -206,16 +207,17 @@ def _passes(volume, view, plan, filt, count, dtype, transfer, tally, third_pass)
             v1.transpose(0, 2, 1), v2[channel].transpose(0, 2, 1), plan.e, plan.d, plan.f,
             plan.t1, lo, hi, filt)
         count["pass2"] += done
-        if third_pass and filt.prefiltered:  # V2 stored [Y, w, X]: pass 3's lines along w
-            lo3, hi3 = _filled(first2.transpose(1, 0), last2.transpose(1, 0), view.height)
-            _prefilter_lines(stored[channel], np.ascontiguousarray(lo3.T),
-                             np.ascontiguousarray(hi3.T), filt, tally)
+        if third_pass and channel == 0:  # like pass 2's, the same for every channel
+            lo3, hi3 = (np.ascontiguousarray(a.T) for a in _filled(
+                first2.transpose(1, 0), last2.transpose(1, 0), view.height))
+        if third_pass:  # V2 stored [Y, w, X]: pass 3's lines along w
+            _prefilter_lines(stored[channel], lo3, hi3, filt, tally)
     count["buffers"] = v1.nbytes + stored.nbytes
     grads = no_gradients(dtype)
     if len(channels) > 1:
         grads = v2[1:]
         grads.flags.writeable = False  # the placeholder's type: one compiled kernel
-    return v2[0], grads, first2, last2
+    return v2[0], grads, (lo3, hi3) if third_pass else None
 
 
 def _prefilter_lines(lines, lo, hi, filt, tally):
@@ -278,18 +280,17 @@ def render_shear3(volume, view, *, filt, transfer, step, early_termination,
     dtype = _intermediate(intermediate, volume)
     start = time.perf_counter()
     tally = Tally()
-    ds, plan, count, (v2, grads, first2, last2) = _first_passes(volume, view, filt, step, dtype,
-                                                                 transfer, tally, True)
+    ds, plan, count, (v2, grads, (lo, hi)) = _first_passes(volume, view, filt, step, dtype,
+                                                           transfer, tally, True)
     # Pass 3 runs along the rays: fused with compositing, no third volume is stored.
-    lo, hi = _filled(first2.transpose(1, 0), last2.transpose(1, 0), view.height)  # [X, Y]
     tables = transfer.segment_table(ds, *reconstructed_range(volume, filt, cardinal=True))
     out = np.zeros(view.shape + (4,))
     resampled = np.zeros(view.height, np.int64)
     counts = np.zeros(view.height, np.int64)
     limits = np.array(volume.shape[::-1], float)[list(plan.order)] - 1.0
     _kernel.resample_composite(
-        v2.transpose(1, 2, 0), plan.i, plan.g, plan.h, plan.t2, np.ascontiguousarray(lo.T),
-        np.ascontiguousarray(hi.T), *filt.code, filt.radius, filt.taps, plan.depth_samples,
+        v2.transpose(1, 2, 0), plan.i, plan.g, plan.h, plan.t2, lo, hi, *filt.code,
+        filt.radius, filt.taps, plan.depth_samples,
         np.linalg.inv(plan.matrix), plan.shift, limits, *tables,
         grads.transpose(0, 2, 3, 1), *kernel_lighting(transfer, view.forward), early_termination,
         out, resampled, counts)
@@ -310,8 +311,8 @@ def render_shear2(volume, view, *, filt, transfer, step, early_termination,
     dtype = _intermediate(intermediate, volume)
     start = time.perf_counter()
     tally = Tally()
-    ds, plan, count, (v2, grads, _, _) = _first_passes(volume, view, filt, step, dtype, transfer,
-                                                       tally, False)
+    ds, plan, count, (v2, grads, _) = _first_passes(volume, view, filt, step, dtype, transfer,
+                                                    tally, False)
     length = abs(plan.i) * ds  # world distance between slices along a ray
     tables = transfer.segment_table(length, *reconstructed_range(volume, filt, cardinal=True))
     m = plan.matrix

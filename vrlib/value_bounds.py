@@ -16,6 +16,8 @@ import math
 
 import numpy as np
 
+from vrlib.prefilter import coefficients
+
 __all__ = ["lattice_sums", "value_bounds", "reconstructed_range"]
 
 _CARDINAL_REACH = 24  # samples a cardinal kernel is summed over each side (|p|^24 < 1e-11)
@@ -28,8 +30,6 @@ def _weights(filt, offsets, cardinal):
     if not (cardinal and filt.prefiltered):
         taps = np.arange(-math.ceil(filt.radius) - 1, math.ceil(filt.radius) + 2)
         return filt(offsets[:, None] - taps[None, :])
-    from vrlib.prefilter import coefficients  # the prefilter needs the volume module
-
     reach = _CARDINAL_REACH
     impulse = coefficients(np.eye(1, 2 * reach + 1, reach)[0], filt.poles)
     taps = np.arange(-reach - 3, reach + 4)
