@@ -159,14 +159,20 @@ def classified_voxel(volume, view, transfer, data, ix, iy, iz, dens, colour):
     return dens, colour
 
 
-def splat_naive(volume, view, filt, transfer, mode):
-    """Splatting by the book: every voxel, every pixel, footprints from the same table.
+def splat_naive(volume, view, filt, transfer, mode, slab_width=1.0):
+    """Splatting by the book: every voxel, every pixel, footprints from the same tables.
 
-    Slices along the major axis front to back; ``"sheet"`` sums a slice's ``f_i FP`` per pixel
-    and classifies the sum as one segment of the slab's length along the ray; ``"direct"``
-    composites each voxel's ``1 - exp(-density(f_i) FP)`` at once, colour ``E(f_i)``.
+    The lattice is extended by ``ceil(r) - 1`` copies of its border samples beyond each face;
+    a voxel within the radius ``r`` of a face has its line integral clipped to each ray's
+    stretch inside the box. ``"sheet"``: slices along the major axis front to back, a slice's
+    ``f_i FP`` summed per pixel and classified as one segment over the slice's share of the
+    ray (``int k`` over the in-box stretch; shares under a quarter of a slab held for the next
+    slice). ``"image-aligned"``: slabs of camera depth, each voxel adding its line integral's
+    part inside the slab and the box, classified over the slab's in-box stretch.
+    ``"direct"``: each voxel composited at once, ``1 - exp(-density(f_i) FP)``, colour
+    ``E(f_i)``.
     """
-    from vrlib.footprint import footprint
+    from vrlib.footprint import footprint, running_integral
     from vrlib.view import principal_axis
 
     volume = coefficient_volume_naive(volume, filt)
@@ -174,49 +180,118 @@ def splat_naive(volume, view, filt, transfer, mode):
     spacing = volume.spacing
     radial = filt.name == "gaussian" and np.ptp(spacing) == 0.0
     fp = footprint(filt, spacing, None if radial else view.basis)
+    cumulative = running_integral(filt)
+    ghost = max(math.ceil(filt.radius) - 1, 0)
     origins, directions = view.rays()
+    t_in, t_out = _clip_to_box(origins, directions, volume.extent[:, 0], volume.extent[:, 1])
     image = np.zeros(view.shape + (4,))
     data = np.asarray(volume.data, dtype=np.float64)
-    order = range(volume.shape[2 - axis]) if ascending else range(volume.shape[2 - axis] - 1,
-                                                                    -1, -1)
-    for s in order:
-        # Within a slice the kernel takes in-plane axis p (the lower free axis) outer and q
-        # inner; direct mode follows the same order.
-        p_axis, q_axis = [a for a in range(3) if a != axis]
-        idx = []
-        for p in range(volume.shape[2 - p_axis]):
-            for q in range(volume.shape[2 - q_axis]):
+    counts = np.array(volume.shape[::-1])
+    p_axis, q_axis = [a for a in range(3) if a != axis]
+
+    def voxels(s):
+        """Slice ``s`` (ghosts included) in the kernel's order: in-plane p outer, q inner."""
+        for p in range(-ghost, counts[p_axis] + ghost):
+            for q in range(-ghost, counts[q_axis] + ghost):
                 ijk = [0, 0, 0]
                 ijk[axis], ijk[p_axis], ijk[q_axis] = s, p, q
-                idx.append(ijk)
-        sheet = np.zeros(view.shape)
-        for ix, iy, iz in idx:
-            f = data[iz, iy, ix]
-            centre = volume.index_to_world([ix, iy, iz])
-            w = centre - origins  # (h, w, 3)
-            t = np.einsum("hwc,hwc->hw", w, directions)
-            offset = t[..., None] * directions - w  # ray point minus voxel, across the ray
-            u = offset @ view.right
-            v = offset @ view.up
-            weight = fp(u, v)
-            if mode == "sheet":
-                sheet += f * weight
-            else:
+                yield ijk
+
+    def value_at(ijk):
+        i, j, k = (min(max(ijk[a], 0), counts[a] - 1) for a in range(3))
+        return data[k, j, i]
+
+    def footprint_of(ijk, lo, hi):
+        """The voxel's line integral on every ray between ray parameters ``lo`` and ``hi``
+        (a rim voxel's clipped to the box)."""
+        centre = volume.index_to_world(ijk)
+        w = centre - origins  # (h, w, 3)
+        t = np.einsum("hwc,hwc->hw", w, directions)
+        offset = t[..., None] * directions - w  # ray point minus voxel, across the ray
+        rim = any(ijk[a] < filt.radius or ijk[a] > counts[a] - 1 - filt.radius
+                  for a in range(3))
+        if rim:
+            lo, hi = np.maximum(lo, t_in), np.minimum(hi, t_out)
+        return fp.between(offset @ view.right, offset @ view.up, lo - t, hi - t,
+                          rho2=np.einsum("hwc,hwc->hw", offset, offset))
+
+    def composite(value, length, where):
+        alpha = -np.expm1(-transfer.opacity_density(value) * length)
+        segment = np.concatenate([transfer.emission(value) * alpha[..., None],
+                                  alpha[..., None]], -1)
+        return np.where(where[..., None], image + (1.0 - image[..., 3:4]) * segment, image)
+
+    order = range(-ghost, counts[axis] + ghost)
+    order = order if ascending else order[::-1]
+    # A pixel a nonzero voxel drew on is "touched"; only touched pixels are classified, and
+    # one stays touched while its sheet is held.
+    sheet, touched = np.zeros(view.shape), np.zeros(view.shape, bool)
+    if mode == "image-aligned":
+        corners = np.array(np.meshgrid(*volume.extent, indexing="ij")).reshape(3, -1).T
+        depths = view.to_camera(corners)[:, 2]
+        width = slab_width * spacing.min()
+        cosine = directions @ view.forward
+        held_length = np.zeros(view.shape)
+        for m in range(max(1, math.ceil((depths.max() - depths.min()) / width))):
+            z_lo = depths.min() + m * width
+            lo = np.maximum(z_lo / cosine, t_in)
+            hi = np.minimum((z_lo + width) / cosine, t_out)
+            for s in order:
+                for ijk in voxels(s):
+                    f = value_at(ijk)
+                    weight = footprint_of(ijk, lo, hi)
+                    sheet += f * weight
+                    touched |= (f != 0.0) & (weight != 0.0)
+            held_length += np.where(touched & (hi - lo > 0), hi - lo, 0.0)
+            # A stretch under a quarter of the slab is held until the ray leaves the box.
+            ready = touched & (held_length > 0) & (
+                (held_length >= 0.25 * width / cosine) | ((z_lo + width) / cosine >= t_out))
+            value = np.where(ready, sheet / np.where(ready, held_length, 1.0), 0.0)
+            image = composite(value, held_length, ready)
+            sheet, touched = np.where(ready, 0.0, sheet), touched & ~ready
+            held_length = np.where(ready, 0.0, held_length)
+    else:
+        slab = spacing[axis] / np.abs(directions[..., axis])
+        held_length, last_length = np.zeros(view.shape), np.zeros(view.shape)
+        grid = np.linspace(-filt.radius, filt.radius, len(cumulative))
+        for number, s in enumerate(order):
+            for ijk in voxels(s):
+                f = value_at(ijk)
+                weight = footprint_of(ijk, -np.inf, np.inf)
+                if mode == "sheet":
+                    sheet += f * weight
+                    touched |= (f != 0.0) & (weight != 0.0)
+                    continue
                 dens = float(transfer.opacity_density(np.array([f]))[0])
                 colour = transfer.emission(np.array([f]))[0]
                 if transfer.needs_gradient:
-                    dens, colour = classified_voxel(volume, view, transfer, data, ix, iy, iz,
+                    i, j, k = (min(max(ijk[a], 0), counts[a] - 1) for a in range(3))
+                    dens, colour = classified_voxel(volume, view, transfer, data, i, j, k,
                                                     dens, colour)
                 alpha = -np.expm1(-dens * weight)
                 segment = np.concatenate([alpha[..., None] * colour, alpha[..., None]], -1)
                 image = image + (1.0 - image[..., 3:4]) * segment
-        if mode == "sheet":
-            length = spacing[axis] / np.abs(directions[..., axis])
-            value = sheet / length
-            alpha = -np.expm1(-transfer.opacity_density(value) * length)
-            segment = np.concatenate([transfer.emission(value) * alpha[..., None],
-                                      alpha[..., None]], -1)
-            image = image + (1.0 - image[..., 3:4]) * segment
+            if mode != "sheet":
+                continue
+            # The slice's share of each ray: int k((x_a(t) - x_s) / h) dt over the box.
+            centre = volume.index_to_world([s] * 3)[axis]
+            ends = [np.interp((origins[..., axis] + t * directions[..., axis] - centre)
+                              / spacing[axis], grid, cumulative) for t in (t_in, t_out)]
+            share = spacing[axis] / directions[..., axis] * (ends[1] - ends[0])
+            held_length += np.where(touched & (t_out > t_in), share, 0.0)
+            length = held_length.copy()
+            ready = touched & (length >= 0.25 * slab)
+            if number == len(order) - 1:  # what is still held goes after the last sheet
+                rest = touched & ~ready
+                small = rest & ~(np.abs(length) > 1e-6 * slab)
+                length = np.where(small, np.where(last_length > 0, last_length,
+                                                  t_out - t_in), length)
+                ready |= (rest & ~small) | (small & (length > 0))
+            value = np.where(ready, sheet / np.where(ready, length, 1.0), 0.0)
+            image = composite(value, length, ready)
+            sheet, touched = np.where(ready, 0.0, sheet), touched & ~ready
+            held_length = np.where(ready, 0.0, held_length)
+            last_length = np.where(ready, length, last_length)
     image = np.maximum(image, 0.0)  # negative lobes: clamped to transparent black
     image[..., 3] = np.minimum(image[..., 3], 1.0)
     return image

@@ -31,9 +31,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from vrlib import validate
+from vrlib._kernels import footprint as _kernel
 from vrlib.filters import Gaussian, make_filter
 
-__all__ = ["Footprint", "footprint", "RADIAL", "PLANAR"]
+__all__ = ["Footprint", "footprint", "running_integral", "RADIAL", "PLANAR"]
 
 RADIAL, PLANAR = 0, 1
 
@@ -50,16 +51,30 @@ class Footprint:
     extent : float
         World distance (radial), or offset along ``u`` (planar), beyond which the footprint is
         zero.
-    extent_v : float
-        Planar: the same along ``v`` (the kernel's support projected on the view's up).
     table : ndarray
         The samples: 1-D (radial) or 2-D (planar).
+    extent_v : float
+        Planar: the same along ``v`` (the kernel's support projected on the view's up).
+    partial : ndarray or None
+        Planar: ``partial[j, i, m]``, the line integral from the support's start to ``s_m``
+        (``s`` over ``[-extent_s, extent_s]`` along the view, from the point of the line
+        nearest the voxel), on the table's ``(v, u)`` grid; the last entry is the whole
+        footprint. Clipped footprints (a line that leaves the volume inside the kernel's
+        support, or a slab of the line) are differences of two entries.
+    extent_s : float
+        Reach of the support along the line.
+    sigma : float
+        Radial: the Gaussian's standard deviation in world units (partial integrals of the
+        radial footprint are in closed form).
     """
 
     kind: int
     extent: float
     table: np.ndarray
     extent_v: float = 0.0
+    partial: np.ndarray | None = None
+    extent_s: float = 0.0
+    sigma: float = 0.0
 
     def __call__(self, u, v):
         """Footprint at plane offsets ``(u, v)`` by the table's linear (radial) or bilinear
@@ -88,6 +103,60 @@ class Footprint:
                  + ty * ((1 - tx) * t[y0 + 1, x0] + tx * t[y0 + 1, x0 + 1]))
         return np.where(inside, value, 0.0)
 
+    def between(self, u, v, s_lo, s_hi, rho2=None):
+        """The footprint at plane offsets ``(u, v)`` counting only the stretch ``[s_lo, s_hi]``
+        of the line (``s`` from the line's point nearest the voxel), as the kernels read it:
+        trilinear in the partial table (planar) or the closed form times the radial table.
+        ``rho2`` is the squared distance of the line from the voxel (radial; default
+        ``u^2 + v^2``).
+
+        Examples
+        --------
+        >>> import numpy as np
+        >>> fp = footprint("trilinear", (1.0, 1.0, 1.0), np.eye(3))
+        >>> whole = float(fp.between(0.0, 0.0, -np.inf, np.inf))
+        >>> front = float(fp.between(0.0, 0.0, -np.inf, 0.0))
+        >>> round(whole, 6), round(front / whole, 6)   # half of a symmetric kernel
+        (1.0, 0.5)
+        """
+        from scipy.special import erf
+
+        u, v, s_lo, s_hi = np.broadcast_arrays(*(np.asarray(a, dtype=np.float64)
+                                                 for a in (u, v, s_lo, s_hi)))
+        lo = np.clip(s_lo, -self.extent_s, self.extent_s)
+        hi = np.clip(s_hi, -self.extent_s, self.extent_s)
+        if self.kind == RADIAL:
+            rho2 = u * u + v * v if rho2 is None else np.asarray(rho2, dtype=np.float64)
+            n = self.table.shape[0]
+            whole = np.interp(rho2 / self.extent**2 * (n - 1), np.arange(n), self.table,
+                              right=0.0)
+            chord = np.sqrt(np.maximum(self.extent**2 - rho2, 0.0))
+            scale = 1.0 / (self.sigma * np.sqrt(2.0))
+            a, b = np.clip(lo, -chord, chord), np.clip(hi, -chord, chord)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                share = (erf(b * scale) - erf(a * scale)) / (2.0 * erf(chord * scale))
+            return np.where((hi > lo) & (b > a), whole * share, 0.0)
+        nv, nu, ns = self.partial.shape
+        x = (u + self.extent) * (nu - 1) / (2.0 * self.extent)
+        y = (v + self.extent_v) * (nv - 1) / (2.0 * self.extent_v)
+        inside = (x >= 0) & (x <= nu - 1) & (y >= 0) & (y <= nv - 1) & (hi > lo)
+        i = np.clip(np.floor(x).astype(int), 0, nu - 2)
+        j = np.clip(np.floor(y).astype(int), 0, nv - 2)
+        tx, ty = x - i, y - j
+
+        def running(s):
+            z = (s + self.extent_s) * (ns - 1) / (2.0 * self.extent_s)
+            m = np.clip(np.floor(z).astype(int), 0, ns - 2)
+            tz = np.clip(z - m, 0.0, 1.0)
+            p = self.partial
+
+            def at(jj, ii):
+                return (1.0 - tz) * p[jj, ii, m] + tz * p[jj, ii, m + 1]
+            value = ((1.0 - ty) * ((1.0 - tx) * at(j, i) + tx * at(j, i + 1))
+                     + ty * ((1.0 - tx) * at(j + 1, i) + tx * at(j + 1, i + 1)))
+            return np.where(z > 0.0, value, 0.0)
+        return np.where(inside, running(hi) - running(lo), 0.0)
+
 
 def _radial_gaussian(filt, h, resolution):
     """Closed form for the ball-truncated Gaussian: with ``s = sigma h``, ``R = radius h``,
@@ -105,41 +174,48 @@ def _radial_gaussian(filt, h, resolution):
     chord = np.sqrt(np.maximum(big_r * big_r - rho2, 0.0))
     fp = (np.exp(-rho2 / (2 * s * s)) * s * math.sqrt(2 * math.pi)
           * special.erf(chord / (s * math.sqrt(2))))
-    return Footprint(RADIAL, big_r, fp * h**3 / mass)
+    return Footprint(RADIAL, big_r, fp * h**3 / mass, extent_s=big_r, sigma=s)
 
 
 def _planar(filt, spacing, basis, resolution):
-    """Quadrature of the separable kernel along the view direction, split at its knots."""
-    right, up, forward = basis
+    """Partial line integrals of the separable kernel along the view, on a grid over the
+    plane and along the line (:func:`vrlib._kernels.footprint.partial_table`); the whole
+    footprint is the last entry."""
+    right, up, _ = basis
     h = np.asarray(spacing, dtype=np.float64)
-    radius = filt.radius
-    # The support is the box radius * h; its projections on the plane's axes bound the table.
-    extent_u = radius * float(np.abs(right) @ h)
-    extent_v = radius * float(np.abs(up) @ h)
-    extent = radius * float(np.linalg.norm(h))  # bounds the line's span through the support
-    grid_u = np.linspace(-extent_u, extent_u, resolution)
-    grid_v = np.linspace(-extent_v, extent_v, resolution)
-    # Knots: where the line crosses p_a / h_a = integer or half-integer (box) for some axis.
-    knots = np.arange(-math.ceil(radius), math.ceil(radius) + 0.5, 0.5)
-    nodes, weights = np.polynomial.legendre.leggauss(12 if isinstance(filt, Gaussian) else 6)
-    table = np.empty((resolution, resolution))
-    rows = max(1, 2048 // resolution)  # table rows per pass, to bound temporary memory
-    for first in range(0, resolution, rows):
-        v, u = np.meshgrid(grid_v[first:first + rows], grid_u, indexing="ij")
-        base = u[..., None] * right + v[..., None] * up  # world offsets on the plane
-        cuts = [np.full(u.shape + (1,), -2 * extent), np.full(u.shape + (1,), 2 * extent)]
-        for a in range(3):
-            if forward[a] != 0.0:
-                cuts.append((knots * h[a] - base[..., a:a + 1]) / forward[a])
-        cuts = np.sort(np.clip(np.concatenate(cuts, axis=-1), -2 * extent, 2 * extent), axis=-1)
-        lo, hi = cuts[..., :-1], cuts[..., 1:]
-        half = 0.5 * (hi - lo)
-        t = 0.5 * (lo + hi)[..., None] + half[..., None] * nodes
-        kernel = np.ones(t.shape)
-        for a in range(3):
-            kernel *= filt((base[..., None, None, a] + t * forward[a]) / h[a])
-        table[first:first + rows] = np.sum(kernel * weights * half[..., None], axis=(-1, -2))
-    return Footprint(PLANAR, extent_u, table, extent_v)
+    # The support is the box radius * h; its projections on the plane's axes bound the table,
+    # and its circumscribed ball bounds the line's stretch through it.
+    extent_u = filt.radius * float(np.abs(right) @ h)
+    extent_v = filt.radius * float(np.abs(up) @ h)
+    extent_s = filt.radius * float(np.linalg.norm(h))
+    nodes, weights = np.polynomial.legendre.leggauss(6)  # stretches are under 0.11 h long
+    partial = np.empty((resolution, resolution, resolution // 2 + 1))
+    _kernel.partial_table(*filt.code, float(filt.radius), h, np.ascontiguousarray(basis).ravel(),
+                          extent_u, extent_v, extent_s, nodes, weights, partial)
+    return Footprint(PLANAR, extent_u, np.ascontiguousarray(partial[..., -1]), extent_v, partial,
+                     extent_s)
+
+
+@functools.lru_cache(maxsize=32)
+def running_integral(filt, entries=2049):
+    """The 1-D kernel's running integral ``int_{-r}^x k`` on ``entries`` points over
+    ``[-r, r]`` (``r`` the radius), each cell integrated by 4-point Gauss-Legendre (exact for
+    the piecewise cubics, whose knots fall on the grid): the share of a ray that a slice of
+    voxels stands for.
+
+    Examples
+    --------
+    >>> table = running_integral(make_filter("trilinear"), 5)
+    >>> table.tolist()                       # tent over [-1, 1] at -1, -0.5, 0, 0.5, 1
+    [0.0, 0.125, 0.5, 0.875, 1.0]
+    """
+    filt = make_filter(filt)
+    edges = np.linspace(-filt.radius, filt.radius, entries)
+    nodes, weights = np.polynomial.legendre.leggauss(4)
+    half = 0.5 * (edges[1] - edges[0])
+    points = 0.5 * (edges[:-1] + edges[1:])[:, None] + half * nodes
+    cells = (filt(points.ravel()).reshape(points.shape) * weights).sum(axis=1) * half
+    return np.concatenate([[0.0], np.cumsum(cells)])
 
 
 @functools.lru_cache(maxsize=32)

@@ -35,7 +35,7 @@ def method_options(method):
     Examples
     --------
     >>> method_options("splat")
-    {'mode': 'sheet', 'footprint_resolution': 129}
+    {'mode': 'sheet', 'footprint_resolution': 129, 'slab_width': 1.0}
     """
     params = inspect.signature(METHODS[method]).parameters.values()
     return {p.name: p.default for p in params

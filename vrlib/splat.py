@@ -16,6 +16,7 @@ that opaque take nothing more (the image changes by at most ``1 - threshold``).
 
 from __future__ import annotations
 
+import math
 import time
 
 import numba
@@ -25,7 +26,7 @@ from vrlib import validate
 from vrlib._kernels import splat as _kernel
 from vrlib._scheduling import balanced_order
 from vrlib.arguments import refuse_gradients
-from vrlib.footprint import RADIAL, footprint
+from vrlib.footprint import RADIAL, footprint, running_integral
 from vrlib.gradients import SLAB, gradient_volumes
 from vrlib.image import Image, RenderStats
 from vrlib.prefilter import Tally, prepared
@@ -35,7 +36,9 @@ from vrlib.view import principal_axis
 __all__ = ["render_splat", "classify_voxels", "MODES"]
 
 #: Compositing modes of the splatter.
-MODES = ("sheet", "direct")
+MODES = ("sheet", "image-aligned", "direct")
+_KERNEL_MODES = {"sheet": _kernel.SHEET, "image-aligned": _kernel.IMAGE,
+                 "direct": _kernel.DIRECT}
 #: Image rows per parallel task.
 BAND = 16
 
@@ -147,23 +150,28 @@ def full_extents(volume, axis):
 
 
 def render_splat(volume, view, *, filt, transfer, step, early_termination, empty_space_skipping,
-                 mode="sheet", footprint_resolution=129):
+                 mode="sheet", footprint_resolution=129, slab_width=1.0):
     """Splat ``volume`` (arguments validated by :func:`vrlib.render`; ``step`` is unused:
     footprints integrate along the whole ray).
 
     Parameters
     ----------
-    mode : {"sheet", "direct"}
-        Sheet buffers (classify the reconstructed slab) or direct (classify each voxel).
+    mode : {"sheet", "image-aligned", "direct"}
+        Axis-aligned sheet buffers (classify each slice's reconstructed slab), image-aligned
+        sheet buffers (classify slabs parallel to the image), or direct (classify each voxel).
     footprint_resolution : int
         Footprint table entries per axis (:func:`vrlib.footprint.footprint`).
+    slab_width : float
+        Image-aligned mode: slab thickness along the view, in units of the smallest voxel
+        spacing (0.1 to 8).
     """
     validate.choice("mode", mode, MODES)
+    slab_width = validate.finite_number("slab_width", slab_width, low=0.1, high=8.0)
     if filt.prefiltered and mode == "direct":
         raise ValueError(f"direct splatting classifies each voxel before reconstruction, and "
                          f"the {filt.name!r} filter's voxels hold spline coefficients, not "
                          f"values to classify; use mode='sheet' (reconstruct, then classify)")
-    if mode == "sheet":
+    if mode != "direct":
         refuse_gradients(transfer, "splatting with sheet buffers", "mode='direct' (each voxel "
                          "classified and shaded), method='raycast' or vrlib.classify")
     start = time.perf_counter()
@@ -178,7 +186,11 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
     radial = footprint(filt, spacing, None, resolution=footprint_resolution) if (
         filt.name == "gaussian" and np.ptp(spacing) == 0.0) else None
     fp = radial or footprint(filt, spacing, view.basis, resolution=footprint_resolution)
-    corners = np.array(np.meshgrid(*extent, indexing="ij")).reshape(3, -1).T
+    # The lattice is extended by its border samples as far as a kernel reaching into the box
+    # needs: ceil(radius) - 1 ghost voxels beyond each face.
+    ghost = max(math.ceil(filt.radius) - 1, 0)
+    reach = extent + np.outer(spacing * ghost, [-1.0, 1.0])
+    corners = np.array(np.meshgrid(*reach, indexing="ij")).reshape(3, -1).T
     depth = view.to_camera(corners)[:, 2].min()
     if view.is_perspective and depth <= 0.0:
         raise ValueError("part of the volume lies behind the eye: splatting cannot draw it; "
@@ -186,10 +198,15 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
     pixel_depth = view.pixel_size / view.distance * depth if view.is_perspective else \
         view.pixel_size
     reach_max = max(fp.extent, fp.extent_v) / pixel_depth
+    # Slabs of the image-aligned mode tile the box's depth range.
+    box_depths = view.to_camera(np.array(np.meshgrid(*extent, indexing="ij")).reshape(3, -1).T)
+    slab = slab_width * float(spacing.min())
+    slab_start = float(box_depths[:, 2].min())
+    n_slabs = max(1, math.ceil((box_depths[:, 2].max() - slab_start) / slab))
     # Values a sheet can hold lie within the reconstruction's bounds; widen them generously
     # (the tables are exact inside and clamp outside).
     lo, hi = reconstructed_range(volume, filt)
-    span = hi - lo
+    span = max(hi - lo, abs(lo), abs(hi))
     vstart, vinv, density, emission = transfer.value_table(lo - 2 * span, hi + 2 * span)
     per_voxel = transfer.needs_gradient  # direct mode: classified voxel by voxel
     voxel_density, voxel_colour = classify_voxels(volume, view, transfer) if per_voxel else (
@@ -197,18 +214,20 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
     marks = voxel_density if per_voxel else drawable(volume, transfer, mode)
     first, last = row_extents(volume, axis, marks) if (
         empty_space_skipping) else full_extents(volume, axis)
-    n_slices = volume.shape[2 - axis]
-    slices = np.arange(n_slices) if ascending else np.arange(n_slices)[::-1]
+    slices = np.arange(-ghost, volume.shape[2 - axis] + ghost)
+    slices = slices if ascending else slices[::-1]
     bands = -(-view.height // BAND)
     out = np.zeros(view.shape + (4,))
     voxels = np.zeros(bands, np.int64)
     pixels = np.zeros(bands, np.int64)
-    dummy1, dummy2 = np.zeros(2), np.zeros((2, 2))
+    dummy1, dummy2, dummy3 = np.zeros(2), np.zeros((2, 2)), np.zeros((2, 2, 2))
     _kernel.splat(
         volume.data, volume.origin, spacing, view.packed(), view.height, view.width, axis,
-        slices, fp.kind, fp.extent, fp.extent_v or fp.extent,
-        fp.table if fp.kind == RADIAL else dummy1,
-        fp.table if fp.kind != RADIAL else dummy2, MODES.index(mode), vstart, vinv, density,
+        slices, ghost, float(filt.radius), running_integral(filt), fp.kind, fp.extent, fp.extent_v or fp.extent,
+        fp.extent_s, fp.sigma, fp.table if fp.kind == RADIAL else dummy1,
+        fp.table if fp.kind != RADIAL else dummy2,
+        fp.partial if fp.kind != RADIAL else dummy3, _KERNEL_MODES[mode], slab_start, slab,
+        n_slabs, vstart, vinv, density,
         emission, per_voxel, voxel_density, voxel_colour, early_termination,
         empty_space_skipping, first, last, reach_max, BAND,
         balanced_order(np.ones(bands), numba.get_num_threads()), out, voxels, pixels,

@@ -4,7 +4,13 @@ measures the rate they allow. The tables themselves are built by :mod:`vrlib.foo
 
 from __future__ import annotations
 
-from vrlib._kernels._jit import jit
+import math
+
+import numpy as np
+from numba import prange
+
+from vrlib._kernels._jit import jit, parallel_jit
+from vrlib._kernels.filters import weight
 
 RADIAL, PLANAR = 0, 1
 
@@ -56,3 +62,114 @@ def footprint_at(kind, extent, extent_v, radial, planar, u, v):
     if j < 0:
         return 0.0
     return planar_at(extent, planar, j, ty, u)
+
+
+@parallel_jit
+def partial_table(kind, p0, p1, p2, radius, spacing, basis, extent_u, extent_v, extent_s,
+                  nodes, weights, table):
+    """Partial line integrals of the separable kernel ``K(p) = prod_a k(p_a / h_a)``:
+    ``table[j, i, m] = int_{-extent_s}^{s_m} K(u_i right + v_j up + t forward) dt`` on the grid
+    ``u_i`` over ``[-extent_u, extent_u]``, ``v_j`` over ``[-extent_v, extent_v]`` and ``s_m``
+    over ``[-extent_s, extent_s]`` (``basis``: the rows right, up, forward, flattened).
+
+    Each stretch between grid points is cut where the line crosses a knot of ``k`` (the integers
+    and half-integers within its ``radius``) and integrated by Gauss-Legendre
+    ``nodes``/``weights`` on ``[-1, 1]`` (exact for the piecewise-polynomial kernels).
+    """
+    nv, nu, ns = table.shape
+    reach = int(math.ceil(radius))
+    n_knots = 4 * reach + 1
+    fwd = (basis[6], basis[7], basis[8])
+    ds = 2.0 * extent_s / (ns - 1)
+    for j in prange(nv):
+        v = -extent_v + 2.0 * extent_v * j / (nv - 1)
+        cuts = np.empty(3 * n_knots)
+        for i in range(nu):
+            u = -extent_u + 2.0 * extent_u * i / (nu - 1)
+            base = (u * basis[0] + v * basis[3], u * basis[1] + v * basis[4],
+                    u * basis[2] + v * basis[5])
+            count = 0
+            for a in range(3):
+                if fwd[a] == 0.0:
+                    continue
+                for n in range(n_knots):
+                    t = ((n - 2 * reach) * 0.5 * spacing[a] - base[a]) / fwd[a]
+                    if -extent_s < t < extent_s:
+                        cuts[count] = t
+                        count += 1
+            cuts[:count].sort()
+            total = 0.0
+            table[j, i, 0] = 0.0
+            c = 0
+            for m in range(1, ns):
+                lo = -extent_s + (m - 1) * ds
+                hi = -extent_s + m * ds if m < ns - 1 else extent_s
+                while c < count and cuts[c] <= lo:
+                    c += 1
+                while True:
+                    stop = hi
+                    if c < count and cuts[c] < hi:
+                        stop = cuts[c]
+                    half = 0.5 * (stop - lo)
+                    mid = 0.5 * (stop + lo)
+                    for g in range(nodes.shape[0]):
+                        t = mid + half * nodes[g]
+                        value = weights[g] * half
+                        for a in range(3):
+                            value *= weight(kind, p0, p1, p2,
+                                            (base[a] + t * fwd[a]) / spacing[a])
+                        total += value
+                    if stop == hi:
+                        break
+                    lo = stop
+                    c += 1
+                table[j, i, m] = total
+
+
+@jit(inline="always")
+def partial_corner(extent, extent_v, nu, nv, u, v):
+    """Cell of the partial table holding plane offset ``(u, v)``: indices ``(j, i)`` and
+    fractions ``(ty, tx)``; ``j = -1`` outside."""
+    x = (u + extent) * ((nu - 1) / (2.0 * extent))
+    y = (v + extent_v) * ((nv - 1) / (2.0 * extent_v))
+    if not (x >= 0.0 and x <= nu - 1 and y >= 0.0 and y <= nv - 1):
+        return -1, 0, 0.0, 0.0
+    j = min(int(y), nv - 2)
+    i = min(int(x), nu - 2)
+    return j, i, y - j, x - i
+
+
+@jit(inline="always")
+def partial_at(partial, extent_s, j, i, ty, tx, s):
+    """The partial table at cell ``(j, i, ty, tx)`` and line position ``s``: the kernel's
+    integral along the line from its start to ``s`` (trilinear)."""
+    ns = partial.shape[2]
+    z = (s + extent_s) * ((ns - 1) / (2.0 * extent_s))
+    if not z > 0.0:
+        return 0.0
+    m = ns - 2
+    tz = 1.0
+    if z < ns - 1:
+        m = int(z)
+        tz = z - m
+    a = (1.0 - tz) * partial[j, i, m] + tz * partial[j, i, m + 1]
+    b = (1.0 - tz) * partial[j, i + 1, m] + tz * partial[j, i + 1, m + 1]
+    c = (1.0 - tz) * partial[j + 1, i, m] + tz * partial[j + 1, i, m + 1]
+    d = (1.0 - tz) * partial[j + 1, i + 1, m] + tz * partial[j + 1, i + 1, m + 1]
+    return (1.0 - ty) * ((1.0 - tx) * a + tx * b) + ty * ((1.0 - tx) * c + tx * d)
+
+
+@jit(inline="always")
+def radial_partial(extent, sigma, s_lo, s_hi, rho2):
+    """Share of the ball-truncated Gaussian's line integral at squared distance ``rho2`` that
+    lies between ``s_lo`` and ``s_hi`` along the line (closed form: the chord's Gaussian is
+    ``exp(-t^2 / 2 sigma^2)`` on ``|t| < sqrt(extent^2 - rho2)``)."""
+    chord = math.sqrt(max(extent * extent - rho2, 0.0))
+    if chord == 0.0:
+        return 0.0
+    scale = 1.0 / (sigma * math.sqrt(2.0))
+    lo = min(max(s_lo, -chord), chord)
+    hi = min(max(s_hi, -chord), chord)
+    if not hi > lo:
+        return 0.0
+    return (math.erf(hi * scale) - math.erf(lo * scale)) / (2.0 * math.erf(chord * scale))

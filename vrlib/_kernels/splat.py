@@ -35,17 +35,20 @@ from vrlib._kernels.camera import (
     on_plane,
     pixel_ray,
     project,
+    ray_box,
 )
 from vrlib._kernels.footprint import (
     RADIAL,
-    footprint_at,
+    partial_at,
+    partial_corner,
     planar_at,
     planar_row,
     radial_at,
+    radial_partial,
 )
 from vrlib._kernels.tables import interpolate, interpolate_channel
 
-SHEET, DIRECT = 0, 1
+SHEET, DIRECT, IMAGE = 0, 1, 2
 
 
 @jit
@@ -106,8 +109,9 @@ def row_extents(marks, axis, first, last):
 
 @jit(inline="always")
 def _deposit(mode, f, fp, dens, er, eg, eb, threshold, sheet, touched, opaque, out, r, r0, c):
-    """One footprint pixel: into the sheet (``SHEET``), or composited at once (``DIRECT``)."""
-    if mode == SHEET:
+    """One footprint pixel: into the sheet (``SHEET``, ``IMAGE``), or composited at once
+    (``DIRECT``)."""
+    if mode != DIRECT:
         sheet[r - r0, c] += f * fp
         touched[r - r0, c] = True
         return
@@ -120,37 +124,119 @@ def _deposit(mode, f, fp, dens, er, eg, eb, threshold, sheet, touched, opaque, o
     opaque[r - r0, c] = out[r, c, 3] >= threshold
 
 
+@jit(inline="always")
+def _composite(out, r, c, value, length, vstart, vinv, dens_tab, emit_tab):
+    """Composite a segment of ``length`` at the constant ``value`` (eqs 1.4, 1.7)."""
+    dens = interpolate(dens_tab, vstart, vinv, value)
+    if not dens > 0.0:
+        return
+    weight = (1.0 - out[r, c, 3]) * -math.expm1(-dens * length)
+    for ch in range(3):
+        out[r, c, ch] += weight * interpolate_channel(emit_tab, vstart, vinv, value, ch)
+    out[r, c, 3] += weight
+
+
+@jit(inline="always")
+def cumulated(cumulative, radius, x):
+    """The running integral of the 1-D kernel up to ``x`` (voxels), from its table over
+    ``[-radius, radius]``."""
+    n = cumulative.shape[0]
+    y = (x + radius) * ((n - 1) / (2.0 * radius))
+    if not y > 0.0:
+        return 0.0
+    if y >= n - 1:
+        return cumulative[n - 1]
+    m = int(y)
+    return cumulative[m] + (y - m) * (cumulative[m + 1] - cumulative[m])
+
+
+@jit(inline="always")
+def _window(base, slope, lo, hi, first, last):
+    """The integers ``x`` in ``[first, last]`` with ``base + slope x`` in ``[lo, hi]``
+    (``first > last`` when none), widened by one for rounding."""
+    if slope == 0.0:
+        if lo <= base <= hi:
+            return first, last
+        return first, first - 1
+    a = (lo - base) / slope
+    b = (hi - base) / slope
+    if a > b:
+        a, b = b, a
+    if not (b >= first - 1 and a <= last + 1):
+        return first, first - 1
+    return max(first, int(math.floor(a)) - 1), min(last, int(math.ceil(b)) + 1)
+
+
+@jit(inline="always")
+def _clipped(fkind, extent, extent_v, extent_s, sigma, radial, planar, partial, u, v, rho2,
+             s_lo, s_hi):
+    """The footprint at plane offsets ``(u, v)`` restricted to ``[s_lo, s_hi]`` along the line
+    (``s`` from the line's point nearest the voxel): whole, partial, or zero."""
+    if not s_hi > s_lo or s_hi <= -extent_s or s_lo >= extent_s:
+        return 0.0
+    if fkind == RADIAL:
+        whole = radial_at(extent, radial, rho2)
+        if s_lo <= -extent_s and s_hi >= extent_s or whole == 0.0:
+            return whole
+        return whole * radial_partial(extent, sigma, s_lo, s_hi, rho2)
+    if s_lo <= -extent_s and s_hi >= extent_s:
+        j, ty = planar_row(extent_v, planar, v)
+        return 0.0 if j < 0 else planar_at(extent, planar, j, ty, u)
+    j, i, ty, tx = partial_corner(extent, extent_v, partial.shape[1], partial.shape[0], u, v)
+    if j < 0:
+        return 0.0
+    return (partial_at(partial, extent_s, j, i, ty, tx, s_hi)
+            - partial_at(partial, extent_s, j, i, ty, tx, s_lo))
+
+
 @parallel_jit
-def splat(data, origin, spacing, camera, height, width, axis, slices,
-          fkind, extent, extent_v, radial, planar, mode, vstart, vinv, dens_tab, emit_tab,
+def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, radius,
+          cumulative, fkind, extent, extent_v, extent_s, sigma, radial, planar, partial, mode,
+          slab_start, slab_width, n_slabs, vstart, vinv, dens_tab, emit_tab,
           per_voxel, voxel_density, voxel_colour, threshold, cull, row_first, row_last,
           reach_max, band, order, out, voxels, pixels):
     """Splat ``data[z, y, x]`` into ``out`` (premultiplied RGBA), bands of ``band`` rows.
 
     ``axis`` (0, 1, 2 for x, y, z) is the slicing axis and ``slices`` its indices front to
-    back. Footprints are ``fkind`` tables (:mod:`vrlib.footprint`) reaching ``extent`` (along
-    the image's right) and ``extent_v`` (up) world units. Classification reads density and
-    emission tables over values (``vstart``, ``vinv``), or in direct mode with ``per_voxel``
-    each voxel's own ``voxel_density`` and ``voxel_colour`` (classified and shaded from its
-    gradient beforehand). With ``cull``, voxels of value zero are
-    never drawn (they add nothing to a sheet) and in direct mode neither are voxels of zero
-    density. Pixels whose opacity has reached ``threshold`` take no more (1 turns that off).
-    ``row_first[s, p]`` and ``row_last[s, p]`` bound the voxels of each row of each slice that
-    can be drawn (the rest are culled: a run-length skip over empty rows and their ends).
-    ``reach_max`` bounds the footprint's reach in pixels over the volume. ``voxels`` and
-    ``pixels`` count, per band, the voxels whose centre falls on it and the footprint pixels
-    drawn.
+    back, ``ghost`` slices beyond each face included: the lattice is extended by repeating its
+    border samples (as every renderer reconstructs), so that the field inside the box is the
+    ray caster's. ``cumulative`` tabulates ``int k`` over ``[-radius, radius]`` (the 1-D
+    kernel's running integral). Footprints are ``fkind`` tables (:mod:`vrlib.footprint`) reaching ``extent``
+    (along the image's right), ``extent_v`` (up) and ``extent_s`` (along the line) world
+    units; a voxel within the filter's ``radius`` (voxels) of a face has its line integrals
+    clipped to the stretch of each ray inside the box (``partial`` table, or ``sigma`` for the
+    radial Gaussian's closed form). ``mode``: ``SHEET`` and ``DIRECT`` walk the slices, one
+    pass each; ``IMAGE`` walks ``n_slabs`` slabs of camera depth ``slab_width`` from
+    ``slab_start``, each voxel adding the part of its line integral that lies in the slab.
+    Classification reads density and emission tables over values (``vstart``, ``vinv``), or in
+    direct mode with ``per_voxel`` each voxel's own ``voxel_density`` and ``voxel_colour``. With
+    ``cull``, voxels of value zero are never drawn and in direct mode neither are voxels of
+    zero density. Pixels whose opacity has reached ``threshold`` take no more (1 turns that
+    off). ``row_first[s, p]`` and ``row_last[s, p]`` bound the voxels of each row of each
+    slice that can be drawn. ``reach_max`` bounds the footprint's reach in pixels over the
+    volume. ``voxels`` and ``pixels`` count, per band, the footprints drawn and the footprint
+    pixels drawn.
     """
     nz, ny, nx = data.shape
     counts = (nx, ny, nz)
-    # In-plane axes p, q of the slices.
     pa = 1 if axis == 0 else 0
     qa = 1 if axis == 2 else 2
-    np_, nq = counts[pa], counts[qa]
+    ns_, np_, nq = counts[axis], counts[pa], counts[qa]
     px = camera[PIXEL]
     perspective = is_perspective(camera)
     fwd = (camera[FORWARD], camera[FORWARD + 1], camera[FORWARD + 2])
-    length_ortho = spacing[axis] / max(abs(fwd[axis]), 1e-300)
+    lo_box = (origin[0], origin[1], origin[2])
+    hi_box = (origin[0] + (nx - 1) * spacing[0], origin[1] + (ny - 1) * spacing[1],
+              origin[2] + (nz - 1) * spacing[2])
+    # Camera depth is affine in the voxel index: depth0 + s ds + p dp + q dq.
+    depth0 = camera_coords(camera, origin[0], origin[1], origin[2])[2]
+    ds = spacing[axis] * fwd[axis]
+    dp = spacing[pa] * fwd[pa]
+    dq = spacing[qa] * fwd[qa]
+    q_lo = min(dq * -ghost, dq * (nq - 1 + ghost))
+    q_hi = max(dq * -ghost, dq * (nq - 1 + ghost))
+    reach_depth = 2.0 * extent_s if perspective else extent_s
+    passes = n_slabs if mode == IMAGE else slices.shape[0]
     for it in prange(order.shape[0]):
         b = order[it]
         r0 = b * band
@@ -158,137 +244,225 @@ def splat(data, origin, spacing, camera, height, width, axis, slices,
         sheet = np.zeros((r1 - r0, width))
         touched = np.zeros((r1 - r0, width), dtype=np.bool_)
         opaque = np.zeros((r1 - r0, width), dtype=np.bool_)  # out[.., 3] >= threshold
+        # Each ray's stretch inside the box; the share of it held in the sheet and the
+        # length the last composited sheet stood for.
+        t_in = np.empty((r1 - r0, width))
+        t_out = np.empty((r1 - r0, width))
+        held_length = np.zeros((r1 - r0, width))
+        last_length = np.zeros((r1 - r0, width))
         for r in range(r0, r1):
             for c in range(width):
                 opaque[r - r0, c] = out[r, c, 3] >= threshold
+                o, d = pixel_ray(camera, height, width, r, c)
+                t_in[r - r0, c], t_out[r - r0, c] = ray_box(o, d, lo_box, hi_box)
         drawn = 0
         counted = 0
         qx = spacing[0] if qa == 0 else 0.0
         qy = spacing[1] if qa == 1 else 0.0
         qz = spacing[2] if qa == 2 else 0.0
-        for s in slices:
-            for p in range(np_):
-                if row_first[s, p] > row_last[s, p]:
-                    continue  # nothing to draw in this row
-                # Voxel (i, j, k) of slice s, in-plane row p, and q = 0.
-                i = s if axis == 0 else p
-                j = s if axis == 1 else (p if axis == 0 else 0)
-                k = s if axis == 2 else 0
-                q_first, q_last = _q_range(
-                    camera, height, origin[0] + i * spacing[0], origin[1] + j * spacing[1],
-                    origin[2] + k * spacing[2], qx, qy, qz, nq, r0 - reach_max - 1.0,
-                    r1 + reach_max + 1.0)
-                q_first = max(q_first, row_first[s, p])
-                q_last = min(q_last, row_last[s, p])
-                for q in range(q_first, q_last + 1):
-                    if qa == 1:
-                        j = q
-                    else:
-                        k = q
-                    f = data[k, j, i]
-                    dens = 0.0
-                    if cull and f == 0.0:
-                        continue  # adds nothing to a sheet, and has no density to draw
-                    if mode == DIRECT:
-                        if per_voxel:
-                            dens = voxel_density[k, j, i]
-                        else:
-                            dens = interpolate(dens_tab, vstart, vinv, f)
-                        if cull and not dens > 0.0:
+        for pass_index in range(passes):
+            z_lo = -math.inf
+            z_hi = math.inf
+            first_slice = pass_index
+            last_slice = pass_index
+            if mode == IMAGE:
+                z_lo = slab_start + pass_index * slab_width
+                z_hi = z_lo + slab_width
+                first_slice = 0
+                last_slice = slices.shape[0] - 1
+            for slice_index in range(first_slice, last_slice + 1):
+                s = slices[slice_index]
+                sc = min(max(s, 0), ns_ - 1)
+                base_s = depth0 + s * ds
+                p_first, p_last = -ghost, np_ - 1 + ghost
+                if mode == IMAGE:
+                    p_first, p_last = _window(base_s, dp, z_lo - reach_depth - q_hi,
+                                              z_hi + reach_depth - q_lo, p_first, p_last)
+                for p in range(p_first, p_last + 1):
+                    pc = min(max(p, 0), np_ - 1)
+                    if row_first[sc, pc] > row_last[sc, pc]:
+                        continue  # nothing to draw in this row
+                    q_first = row_first[sc, pc] if row_first[sc, pc] > 0 else -ghost
+                    q_last = row_last[sc, pc] if row_last[sc, pc] < nq - 1 else nq - 1 + ghost
+                    if mode == IMAGE:
+                        q_first, q_last = _window(base_s + p * dp, dq, z_lo - reach_depth,
+                                                  z_hi + reach_depth, q_first, q_last)
+                        if q_first > q_last:
                             continue
-                    x = origin[0] + i * spacing[0]
-                    y = origin[1] + j * spacing[1]
-                    z = origin[2] + k * spacing[2]
-                    row_c, col_c, depth = project(camera, height, width, x, y, z)
-                    if not depth > 0.0 or row_c != row_c:
-                        continue
-                    reach_u = extent / px / depth if perspective else extent / px
-                    reach_v = extent_v / px / depth if perspective else extent_v / px
-                    top = max(r0, int(math.ceil(row_c - reach_v - 0.5)))
-                    bottom = min(r1 - 1, int(math.floor(row_c + reach_v - 0.5)))
-                    if top > bottom:
-                        continue
-                    left = max(0, int(math.ceil(col_c - reach_u - 0.5)))
-                    right = min(width - 1, int(math.floor(col_c + reach_u - 0.5)))
-                    if left > right:
-                        continue
-                    if r0 <= row_c < r1 or (b == 0 and row_c < 0) or (
-                            r1 == height and row_c >= height):
-                        counted += 1
-                    er = eg = eb = 0.0
-                    if mode == DIRECT and per_voxel:
-                        er = voxel_colour[k, j, i, 0]
-                        eg = voxel_colour[k, j, i, 1]
-                        eb = voxel_colour[k, j, i, 2]
-                    elif mode == DIRECT:
-                        er = interpolate_channel(emit_tab, vstart, vinv, f, 0)
-                        eg = interpolate_channel(emit_tab, vstart, vinv, f, 1)
-                        eb = interpolate_channel(emit_tab, vstart, vinv, f, 2)
-                    for r in range(top, bottom + 1):
-                        if perspective:
-                            for c in range(left, right + 1):
-                                if opaque[r - r0, c]:
-                                    continue
-                                o, d = pixel_ray(camera, height, width, r, c)
-                                wx, wy, wz = x - o[0], y - o[1], z - o[2]
-                                t = wx * d[0] + wy * d[1] + wz * d[2]
-                                # Ray point minus voxel, perpendicular to the ray.
-                                ox_, oy_, oz_ = t * d[0] - wx, t * d[1] - wy, t * d[2] - wz
-                                u, v = on_plane(camera, ox_, oy_, oz_)
-                                fp = footprint_at(fkind, extent, extent_v, radial, planar, u, v)
-                                if fp != 0.0:
-                                    drawn += 1
-                                    _deposit(mode, f, fp, dens, er, eg, eb, threshold, sheet,
-                                             touched, opaque, out, r, r0, c)
-                            continue
-                        # Orthographic: the row's offset v and its table row are shared.
-                        v = (row_c - r - 0.5) * px
-                        if fkind == RADIAL:
-                            vv = v * v
-                            for c in range(left, right + 1):
-                                u = (c + 0.5 - col_c) * px
-                                fp = radial_at(extent, radial, u * u + vv)
-                                if fp != 0.0 and not opaque[r - r0, c]:
-                                    drawn += 1
-                                    _deposit(mode, f, fp, dens, er, eg, eb, threshold, sheet,
-                                             touched, opaque, out, r, r0, c)
+                    # Voxel (i, j, k) of slice s, in-plane row p, and q = -ghost.
+                    i = s if axis == 0 else p
+                    j = s if axis == 1 else (p if axis == 0 else -ghost)
+                    k = s if axis == 2 else -ghost
+                    band_first, band_last = _q_range(
+                        camera, height, origin[0] + i * spacing[0],
+                        origin[1] + j * spacing[1], origin[2] + k * spacing[2], qx, qy, qz,
+                        nq + 2 * ghost, r0 - reach_max - 1.0, r1 + reach_max + 1.0)
+                    q_first = max(q_first, band_first - ghost)
+                    q_last = min(q_last, band_last - ghost)
+                    for q in range(q_first, q_last + 1):
+                        if qa == 1:
+                            j = q
                         else:
-                            row, ty = planar_row(extent_v, planar, v)
-                            if row < 0:
+                            k = q
+                        ic = min(max(i, 0), nx - 1)
+                        jc = min(max(j, 0), ny - 1)
+                        kc = min(max(k, 0), nz - 1)
+                        f = data[kc, jc, ic]
+                        dens = 0.0
+                        if cull and f == 0.0:
+                            continue  # adds nothing to a sheet, and has no density to draw
+                        if mode == DIRECT:
+                            if per_voxel:
+                                dens = voxel_density[kc, jc, ic]
+                            else:
+                                dens = interpolate(dens_tab, vstart, vinv, f)
+                            if cull and not dens > 0.0:
                                 continue
-                            for c in range(left, right + 1):
-                                u = (c + 0.5 - col_c) * px
-                                fp = planar_at(extent, planar, row, ty, u)
-                                if fp != 0.0 and not opaque[r - r0, c]:
-                                    drawn += 1
-                                    _deposit(mode, f, fp, dens, er, eg, eb, threshold, sheet,
-                                             touched, opaque, out, r, r0, c)
-            if mode == SHEET:
-                # Classify the sheet as one segment per pixel and composite it (eqs 1.4, 1.7).
-                for r in range(r0, r1):
-                    for c in range(width):
-                        if not touched[r - r0, c]:
+                        x = origin[0] + i * spacing[0]
+                        y = origin[1] + j * spacing[1]
+                        z = origin[2] + k * spacing[2]
+                        row_c, col_c, depth = project(camera, height, width, x, y, z)
+                        if row_c != row_c:
+                            continue  # behind a perspective eye
+                        reach_u = extent / px / depth if perspective else extent / px
+                        reach_v = extent_v / px / depth if perspective else extent_v / px
+                        top = max(r0, int(math.ceil(row_c - reach_v - 0.5)))
+                        bottom = min(r1 - 1, int(math.floor(row_c + reach_v - 0.5)))
+                        if top > bottom:
                             continue
-                        touched[r - r0, c] = False
-                        integral = sheet[r - r0, c]
-                        sheet[r - r0, c] = 0.0
-                        if perspective:
-                            o, d = pixel_ray(camera, height, width, r, c)
-                            length = spacing[axis] / max(abs(d[axis]), 1e-300)
-                        else:
-                            length = length_ortho
-                        value = integral / length
-                        dens = interpolate(dens_tab, vstart, vinv, value)
-                        if not dens > 0.0:
+                        left = max(0, int(math.ceil(col_c - reach_u - 0.5)))
+                        right = min(width - 1, int(math.floor(col_c + reach_u - 0.5)))
+                        if left > right:
                             continue
-                        weight = (1.0 - out[r, c, 3]) * -math.expm1(-dens * length)
-                        out[r, c, 0] += weight * interpolate_channel(emit_tab, vstart, vinv,
-                                                                             value, 0)
-                        out[r, c, 1] += weight * interpolate_channel(emit_tab, vstart, vinv,
-                                                                             value, 1)
-                        out[r, c, 2] += weight * interpolate_channel(emit_tab, vstart, vinv,
-                                                                             value, 2)
-                        out[r, c, 3] += weight
-                        opaque[r - r0, c] = out[r, c, 3] >= threshold
+                        # Clipped: within the filter's radius of a face, or split into slabs.
+                        clipped = mode == IMAGE or (
+                            i < radius or i > nx - 1 - radius or j < radius
+                            or j > ny - 1 - radius or k < radius or k > nz - 1 - radius)
+                        if r0 <= row_c < r1 or (b == 0 and row_c < 0) or (
+                                r1 == height and row_c >= height):
+                            counted += 1
+                        er = eg = eb = 0.0
+                        if mode == DIRECT and per_voxel:
+                            er = voxel_colour[kc, jc, ic, 0]
+                            eg = voxel_colour[kc, jc, ic, 1]
+                            eb = voxel_colour[kc, jc, ic, 2]
+                        elif mode == DIRECT:
+                            er = interpolate_channel(emit_tab, vstart, vinv, f, 0)
+                            eg = interpolate_channel(emit_tab, vstart, vinv, f, 1)
+                            eb = interpolate_channel(emit_tab, vstart, vinv, f, 2)
+                        for r in range(top, bottom + 1):
+                            if perspective or clipped:
+                                for c in range(left, right + 1):
+                                    if opaque[r - r0, c]:
+                                        continue
+                                    if perspective:
+                                        o, d = pixel_ray(camera, height, width, r, c)
+                                        wx, wy, wz = x - o[0], y - o[1], z - o[2]
+                                        t = wx * d[0] + wy * d[1] + wz * d[2]
+                                        # Ray point minus voxel, perpendicular to the ray.
+                                        ox_, oy_, oz_ = (t * d[0] - wx, t * d[1] - wy,
+                                                         t * d[2] - wz)
+                                        u, v = on_plane(camera, ox_, oy_, oz_)
+                                        rho2 = ox_ * ox_ + oy_ * oy_ + oz_ * oz_
+                                        cosine = d[0] * fwd[0] + d[1] * fwd[1] + d[2] * fwd[2]
+                                    else:
+                                        t = depth
+                                        v = (row_c - r - 0.5) * px
+                                        u = (c + 0.5 - col_c) * px
+                                        rho2 = u * u + v * v
+                                        cosine = 1.0
+                                    lo = t_in[r - r0, c] if clipped else -math.inf
+                                    hi = t_out[r - r0, c] if clipped else math.inf
+                                    if mode == IMAGE:
+                                        lo = max(lo, z_lo / cosine)
+                                        hi = min(hi, z_hi / cosine)
+                                    fp = _clipped(fkind, extent, extent_v, extent_s, sigma,
+                                                  radial, planar, partial, u, v, rho2,
+                                                  lo - t, hi - t)
+                                    if fp != 0.0:
+                                        drawn += 1
+                                        _deposit(mode, f, fp, dens, er, eg, eb, threshold,
+                                                 sheet, touched, opaque, out, r, r0, c)
+                                continue
+                            # Orthographic, whole footprints: the row's offset v and its table
+                            # row are shared.
+                            v = (row_c - r - 0.5) * px
+                            if fkind == RADIAL:
+                                vv = v * v
+                                for c in range(left, right + 1):
+                                    u = (c + 0.5 - col_c) * px
+                                    fp = radial_at(extent, radial, u * u + vv)
+                                    if fp != 0.0 and not opaque[r - r0, c]:
+                                        drawn += 1
+                                        _deposit(mode, f, fp, dens, er, eg, eb, threshold,
+                                                 sheet, touched, opaque, out, r, r0, c)
+                            else:
+                                row, ty = planar_row(extent_v, planar, v)
+                                if row < 0:
+                                    continue
+                                for c in range(left, right + 1):
+                                    u = (c + 0.5 - col_c) * px
+                                    fp = planar_at(extent, planar, row, ty, u)
+                                    if fp != 0.0 and not opaque[r - r0, c]:
+                                        drawn += 1
+                                        _deposit(mode, f, fp, dens, er, eg, eb, threshold,
+                                                 sheet, touched, opaque, out, r, r0, c)
+            if mode == DIRECT:
+                continue
+            # Classify the sheet per pixel as one segment and composite it (eqs 1.4, 1.7).
+            # IMAGE: the slab's stretch of the ray inside the box (a stretch under a quarter
+            # of the slab, where the ray enters, is held for the next slab). SHEET: the slice's share of
+            # the ray inside the box, int k((x_a(t) - x_s) / h) dt over it (the shares of all
+            # slices, ghosts included, sum to the stretch); a share under a quarter of a
+            # slab's length (the slice near where the ray enters or leaves) is held for the
+            # next slice, and what is held at the end is composited after the last one (over
+            # its own share, which may be negative for kernels with negative lobes).
+            s = slices[pass_index] if mode == SHEET else 0
+            for r in range(r0, r1):
+                for c in range(width):
+                    if not touched[r - r0, c]:
+                        continue
+                    o, d = pixel_ray(camera, height, width, r, c)
+                    a = t_in[r - r0, c]
+                    e = t_out[r - r0, c]
+                    if mode == IMAGE:
+                        cosine = d[0] * fwd[0] + d[1] * fwd[1] + d[2] * fwd[2]
+                        stretch = min(e, z_hi / cosine) - max(a, z_lo / cosine)
+                        if stretch > 0.0:
+                            held_length[r - r0, c] += stretch
+                        length = held_length[r - r0, c]
+                        if not (length >= 0.25 * slab_width / cosine
+                                or z_hi / cosine >= e) or not length > 0.0:
+                            continue
+                        held_length[r - r0, c] = 0.0
+                    else:
+                        if d[axis] != 0.0 and e > a:
+                            centre = origin[axis] + s * spacing[axis]
+                            share = spacing[axis] / d[axis] * (
+                                cumulated(cumulative, radius,
+                                          (o[axis] + e * d[axis] - centre) / spacing[axis])
+                                - cumulated(cumulative, radius,
+                                            (o[axis] + a * d[axis] - centre) / spacing[axis]))
+                            held_length[r - r0, c] += share
+                        length = held_length[r - r0, c]
+                        slab = spacing[axis] / abs(d[axis])
+                        if not length >= 0.25 * slab:
+                            if pass_index < passes - 1:
+                                continue
+                            if not abs(length) > 1e-6 * slab:
+                                # No share to divide by: the last composited length (or the
+                                # whole stretch) stands for it.
+                                length = last_length[r - r0, c]
+                                if not length > 0.0:
+                                    length = e - a
+                                    if not length > 0.0:
+                                        continue
+                        held_length[r - r0, c] = 0.0
+                        last_length[r - r0, c] = length
+                    touched[r - r0, c] = False
+                    value = sheet[r - r0, c] / length
+                    sheet[r - r0, c] = 0.0
+                    _composite(out, r, c, value, length, vstart, vinv, dens_tab, emit_tab)
+                    opaque[r - r0, c] = out[r, c, 3] >= threshold
         voxels[b] = counted
         pixels[b] = drawn
