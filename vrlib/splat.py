@@ -1,17 +1,35 @@
 """Splatting (Westover 1989, 1990): the footprint method the thesis found most efficient.
 
 Each voxel's 3-D reconstruction kernel is projected onto the image as a precomputed 2-D
-footprint (:mod:`vrlib.footprint`): the kernel's line integral along the view. Slices of voxels
-perpendicular to the volume axis most parallel to the view are taken front to back and
-composited either through sheet buffers (``mode="sheet"``: reconstruct, then classify) or voxel
-by voxel (``mode="direct"``: classify each voxel, then draw it). Under the glow transfer
-function both compute the exact line integral of the reconstructed field; they differ for
-nonlinear transfer functions, where classifying before reconstruction blurs the transfer
-function's edges.
+footprint (:mod:`vrlib.footprint`): the kernel's line integral along the view. Three ways to
+composite (``mode``):
+
+* ``"sheet"``: axis-aligned sheet buffers (Westover 1990). Slices of voxels perpendicular to the
+  volume axis most parallel to the view are taken front to back; a slice's footprints are summed
+  into a sheet, classified (reconstruct, then classify) and composited. The sheet axis switches
+  when the view crosses a diagonal, and the image jumps ("popping").
+* ``"image-aligned"``: image-aligned sheet buffers (Mueller and Crawfis 1998). Slabs parallel to
+  the image, ``slab_width`` voxels thick, are taken front to back; each voxel adds to a slab the
+  part of its line integral inside it. No axis to switch, no popping; each voxel is drawn once
+  per slab its kernel reaches (about ``2 r sqrt(3) + 1`` times).
+* ``"direct"`` (Westover 1989): each voxel is classified by its own value, then drawn.
+
+Under the glow transfer function all three compute the line integral of the reconstructed
+field; they differ for nonlinear transfer functions, where classifying before reconstruction
+blurs the transfer function's edges, and slabs of different shapes average different stretches.
+
+The field is the ray caster's: the lattice is extended by repeating its border samples, and
+the line integral of every kernel within its radius of a face is clipped to each ray's stretch
+inside the volume's box (partial footprint tables), so splatting converges to the same image as
+ray casting with the same filter. In perspective the radially symmetric Gaussian footprint is
+exact for every ray; a planar footprint (every other filter) is tabulated for the view's axis and
+used for every ray, off by an amount that grows with the ray's angle to the axis.
 
 Skips: voxels with zero value (and in direct mode zero density) are never drawn, the thesis's
-advantage on sparse data; with ``early_termination`` below 1, footprint pixels that are already
-that opaque take nothing more (the image changes by at most ``1 - threshold``).
+advantage on sparse data; in sheet modes neither are voxels whose neighbourhood the transfer
+function makes transparent (:func:`drawable`); with ``early_termination`` below 1, footprint
+pixels that are already that opaque take nothing more (the image changes by at most
+``1 - threshold``).
 """
 
 from __future__ import annotations
@@ -30,7 +48,7 @@ from vrlib.footprint import RADIAL, footprint, running_integral
 from vrlib.gradients import SLAB, gradient_volumes
 from vrlib.image import Image, RenderStats
 from vrlib.prefilter import Tally, prepared
-from vrlib.value_bounds import reconstructed_range
+from vrlib.value_bounds import reconstructed_range, subset_bounds
 from vrlib.view import principal_axis
 
 __all__ = ["render_splat", "classify_voxels", "MODES"]
@@ -41,6 +59,8 @@ _KERNEL_MODES = {"sheet": _kernel.SHEET, "image-aligned": _kernel.IMAGE,
                  "direct": _kernel.DIRECT}
 #: Image rows per parallel task.
 BAND = 16
+#: Cells per block (each axis) of the transfer-function culling in sheet modes.
+CULL_BLOCK = 4
 
 
 def _slice_order(array, axis):
@@ -50,20 +70,48 @@ def _slice_order(array, axis):
     return np.transpose(array, (2 - axis, 2 - p_axis, 2 - q_axis))
 
 
-def drawable(volume, transfer, mode):
-    """Nonzero where the splatter must draw: the samples themselves (sheet mode; zeros add
-    nothing to a sheet), or a mask of nonzero density (direct mode, evaluated a z-slab at a
-    time).
+def drawable(volume, filt, transfer, mode, *, cull=True):
+    """Nonzero where the splatter must draw.
+
+    Direct mode: the voxels of nonzero density (evaluated a z-slab at a time). Sheet modes: the
+    nonzero samples, less (with ``cull``) every voxel whose neighbourhood makes it invisible:
+    a point within a voxel's support gathers samples within ``2 ceil(r) - 1`` voxels of it, so
+    when the transfer function gives zero opacity to every sum of those samples weighted by
+    the kernel, whichever of them are drawn (:func:`vrlib.value_bounds.subset_bounds`), the
+    voxel only ever adds to transparent points. Neighbourhoods are taken per block of 4^3
+    cells from the volume's min-max pyramid (two voxels wider for axis-aligned sheets). Leaving
+    such voxels out changes no point's classification; a sheet, which classifies a mean over a
+    stretch of the ray, can still change by rounding-level amounts (measured in the report's
+    stability chapter and checked in the tests).
 
     Examples
     --------
-    >>> from vrlib import Volume, Glow
-    >>> drawable(Volume(np.array([[[0.0, -1.0], [2.0, 0.0]]] * 2)), Glow(1.0), "direct")[0]
+    >>> from vrlib import Volume, Glow, LookupTransfer, make_filter
+    >>> data = np.full((9, 9, 9), 0.1); data[0, 0, 0] = 1.0
+    >>> step = LookupTransfer([0.0, 0.0, 0.0, 5.0, 5.0])    # transparent below 0.5
+    >>> marks = drawable(Volume(data), make_filter("trilinear"), step, "sheet")
+    >>> int(np.count_nonzero(marks)), data.size    # the samples of the first block are kept
+    (64, 729)
+    >>> drawable(Volume(np.array([[[0.0, -1.0], [2.0, 0.0]]] * 2)), make_filter("trilinear"),
+    ...          Glow(1.0), "direct")[0]
     array([[False, False],
            [ True, False]])
     """
-    if mode == "sheet":
-        return volume.data  # nonzero values are the ones to draw
+    if mode != "direct":
+        if not cull:
+            return volume.data  # nonzero values are the ones to draw
+        # Axis-aligned sheets average a slice's kernels over the stretch of the ray they
+        # cover, beyond the support's points: two voxels more keep that stretch transparent.
+        reach = 2 * math.ceil(filt.radius) - 1 + (2 if mode == "sheet" else 0)
+        pyr = volume.minmax_pyramid(CULL_BLOCK, margin=reach)
+        low, high = subset_bounds(pyr.minimum[0].astype(np.float64),
+                                  pyr.maximum[0].astype(np.float64), filt)
+        visible = np.asarray(transfer.max_density(low, high)) > 0.0
+        # Sample i belongs to block min(i // 4, blocks - 1), whose samples include it.
+        index = [np.minimum(np.arange(n) // CULL_BLOCK, visible.shape[a] - 1)
+                 for a, n in enumerate(volume.shape)]
+        keep = visible[np.ix_(*index)]
+        return np.where(keep, volume.data, 0.0) if not keep.all() else volume.data
     mask = np.empty(volume.shape, dtype=bool)
     for z in range(0, volume.shape[0], 16):
         mask[z:z + 16] = transfer.opacity_density(volume.data[z:z + 16]) > 0.0
@@ -149,6 +197,13 @@ def full_extents(volume, axis):
     return (np.zeros(shape[:2], np.int64), np.full(shape[:2], shape[2] - 1, np.int64))
 
 
+def _depths(view, box):
+    """Smallest and largest camera depth of the corners of ``box`` (``[[xmin, xmax], ...]``)."""
+    corners = np.array(np.meshgrid(*box, indexing="ij")).reshape(3, -1).T
+    depths = view.to_camera(corners)[:, 2]
+    return float(depths.min()), float(depths.max())
+
+
 def render_splat(volume, view, *, filt, transfer, step, early_termination, empty_space_skipping,
                  mode="sheet", footprint_resolution=129, slab_width=1.0):
     """Splat ``volume`` (arguments validated by :func:`vrlib.render`; ``step`` is unused:
@@ -189,20 +244,26 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
     # The lattice is extended by its border samples as far as a kernel reaching into the box
     # needs: ceil(radius) - 1 ghost voxels beyond each face.
     ghost = max(math.ceil(filt.radius) - 1, 0)
-    reach = extent + np.outer(spacing * ghost, [-1.0, 1.0])
-    corners = np.array(np.meshgrid(*reach, indexing="ij")).reshape(3, -1).T
-    depth = view.to_camera(corners)[:, 2].min()
+    depth, farthest = _depths(view, extent)
     if view.is_perspective and depth <= 0.0:
         raise ValueError("part of the volume lies behind the eye: splatting cannot draw it; "
                          "move the eye back or use method='raycast'")
-    pixel_depth = view.pixel_size / view.distance * depth if view.is_perspective else \
-        view.pixel_size
-    reach_max = max(fp.extent, fp.extent_v) / pixel_depth
+    # Perspective: ghost voxels at or behind the eye (an eye within a voxel of a face) are not
+    # drawn, nor any nearer than half the box's depth, which bounds every footprint's reach.
+    lattice = extent + np.outer(spacing * ghost, [-1.0, 1.0])
+    near = _depths(view, lattice)[0]
+    near = near if near > 0.0 else 0.5 * depth
+    reach_max = max(fp.extent, fp.extent_v) / view.pixel_size
+    if view.is_perspective:
+        # A footprint reaches (support radius / pixel at its depth) x (1 + r^2) pixels, r the
+        # image-plane radius (unit distance) where it lands.
+        camera = view.to_camera(np.array(np.meshgrid(*lattice, indexing="ij")).reshape(3, -1).T)
+        spread = np.hypot(camera[:, 0], camera[:, 1]) / np.maximum(camera[:, 2], near)
+        reach_max = fp.extent_s * (1.0 + float(spread.max()) ** 2) / (
+            view.pixel_size / view.distance * near)
     # Slabs of the image-aligned mode tile the box's depth range.
-    box_depths = view.to_camera(np.array(np.meshgrid(*extent, indexing="ij")).reshape(3, -1).T)
     slab = slab_width * float(spacing.min())
-    slab_start = float(box_depths[:, 2].min())
-    n_slabs = max(1, math.ceil((box_depths[:, 2].max() - slab_start) / slab))
+    n_slabs = max(1, math.ceil((farthest - depth) / slab))
     # Values a sheet can hold lie within the reconstruction's bounds; widen them generously
     # (the tables are exact inside and clamp outside).
     lo, hi = reconstructed_range(volume, filt)
@@ -211,7 +272,14 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
     per_voxel = transfer.needs_gradient  # direct mode: classified voxel by voxel
     voxel_density, voxel_colour = classify_voxels(volume, view, transfer) if per_voxel else (
         np.zeros((1, 1, 1), np.float32), np.zeros((1, 1, 1, 3), np.float32))
-    marks = voxel_density if per_voxel else drawable(volume, transfer, mode)
+    if per_voxel:
+        marks = voxel_density
+    elif mode == "direct":
+        marks = drawable(volume, filt, transfer, mode)
+    else:  # the samples less the voxels culled by the transfer function, kept with the volume
+        marks = volume.cached(("splat-drawn", filt, transfer, empty_space_skipping),
+                              lambda: drawable(volume, filt, transfer, mode,
+                                               cull=empty_space_skipping), keep=2)
     first, last = row_extents(volume, axis, marks) if (
         empty_space_skipping) else full_extents(volume, axis)
     slices = np.arange(-ghost, volume.shape[2 - axis] + ghost)
@@ -222,14 +290,15 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
     pixels = np.zeros(bands, np.int64)
     dummy1, dummy2, dummy3 = np.zeros(2), np.zeros((2, 2)), np.zeros((2, 2, 2))
     _kernel.splat(
-        volume.data, volume.origin, spacing, view.packed(), view.height, view.width, axis,
+        volume.data if mode == "direct" else marks, volume.origin, spacing, view.packed(), view.height, view.width, axis,
         slices, ghost, float(filt.radius), running_integral(filt), fp.kind, fp.extent, fp.extent_v or fp.extent,
         fp.extent_s, fp.sigma, fp.table if fp.kind == RADIAL else dummy1,
         fp.table if fp.kind != RADIAL else dummy2,
-        fp.partial if fp.kind != RADIAL else dummy3, _KERNEL_MODES[mode], slab_start, slab,
+        fp.partial if fp.kind != RADIAL else dummy3, _KERNEL_MODES[mode], depth, slab,
         n_slabs, vstart, vinv, density,
         emission, per_voxel, voxel_density, voxel_colour, early_termination,
-        empty_space_skipping, first, last, reach_max, BAND,
+        empty_space_skipping, first, last, near if view.is_perspective else -math.inf,
+        reach_max, BAND,
         balanced_order(np.ones(bands), numba.get_num_threads()), out, voxels, pixels,
     )
     drawn = int(pixels.sum())

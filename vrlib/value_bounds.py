@@ -18,7 +18,7 @@ import numpy as np
 
 from vrlib.prefilter import coefficients
 
-__all__ = ["lattice_sums", "value_bounds", "reconstructed_range"]
+__all__ = ["lattice_sums", "value_bounds", "subset_bounds", "reconstructed_range"]
 
 _CARDINAL_REACH = 24  # samples a cardinal kernel is summed over each side (|p|^24 < 1e-11)
 
@@ -92,6 +92,32 @@ def value_bounds(low, high, filt, *, cardinal=False):
     centre, half = 0.5 * (low + high), 0.5 * (high - low)
     lo = np.minimum(centre * s_min, centre * s_max) - a_max * half
     hi = np.maximum(centre * s_min, centre * s_max) + a_max * half
+    if np.ndim(lo) == 0:
+        return float(lo), float(hi)
+    return lo, hi
+
+
+def subset_bounds(low, high, filt):
+    """Bounds ``(lo, hi)`` on ``sum_{j in S} w_j f_j`` for every subset ``S`` of the samples
+    that ``filt``'s kernel weights at one point, with the samples within ``[low, high]``
+    (floats or arrays): what a splatter's sheet can hold at a point when some voxels are not
+    drawn. The weights' positive and negative parts sum to at most ``(a + s_max) / 2`` and
+    ``(a - s_min) / 2`` (:func:`lattice_sums`).
+
+    Examples
+    --------
+    >>> from vrlib import make_filter
+    >>> [round(b, 6) for b in subset_bounds(0.2, 0.5, make_filter("trilinear"))]
+    [0.0, 0.5]
+    >>> lo, hi = subset_bounds(0.2, 0.5, make_filter("catmull-rom"))
+    >>> bool(lo < 0.0 and hi > 0.5)                            # negative lobes
+    True
+    """
+    s_min, s_max, a_max = lattice_sums(filt)
+    positive, negative = 0.5 * (a_max + s_max), max(0.5 * (a_max - s_min), 0.0)
+    low, high = np.minimum(low, 0.0), np.maximum(high, 0.0)
+    lo = positive * low - negative * high
+    hi = positive * high - negative * low
     if np.ndim(lo) == 0:
         return float(lo), float(hi)
     return lo, hi

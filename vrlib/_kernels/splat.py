@@ -64,18 +64,22 @@ def _q_range(camera, height, x0, y0, z0, dx, dy, dz, nq, row_lo, row_hi):
         c, d = 1.0, 0.0
     elif c <= 0.0 or c + d * (nq - 1) <= 0.0:
         return 0, nq - 1  # part of the line is behind the eye: take it all
-    # row(q) = h/2 - (a + b q) / (px (c + d q)); solve row(q) = R for both ends.
+    # row(q) = h/2 - (a + b q) / (px (c + d q)), monotone on [0, nq - 1]: a target row beyond
+    # the rows of the ends maps to that end, one between them is solved for.
+    first = 0.5 * height - a / (px * c)
+    last = 0.5 * height - (a + b * (nq - 1)) / (px * (c + d * (nq - 1)))
+    if max(first, last) < row_lo or min(first, last) > row_hi:
+        return 0, -1
     lo = math.inf
     hi = -math.inf
     for target in (row_lo, row_hi):
-        k = (0.5 * height - target) * px
-        denom = b - k * d
-        if abs(denom) < 1e-300:
-            row = 0.5 * height - a / (px * c)
-            if row_lo <= row <= row_hi:
-                return 0, nq - 1
-            return 0, -1
-        q = (k * c - a) / denom
+        if target <= min(first, last):
+            q = 0.0 if first <= last else nq - 1.0
+        elif target >= max(first, last):
+            q = nq - 1.0 if first <= last else 0.0
+        else:
+            k = (0.5 * height - target) * px
+            q = (k * c - a) / (b - k * d)
         lo = min(lo, q)
         hi = max(hi, q)
     return max(0, int(math.floor(lo)) - 1), min(nq - 1, int(math.ceil(hi)) + 1)
@@ -164,6 +168,8 @@ def _window(base, slope, lo, hi, first, last):
         a, b = b, a
     if not (b >= first - 1 and a <= last + 1):
         return first, first - 1
+    a = max(a, first - 1.0)
+    b = min(b, last + 1.0)
     return max(first, int(math.floor(a)) - 1), min(last, int(math.ceil(b)) + 1)
 
 
@@ -194,7 +200,7 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
           cumulative, fkind, extent, extent_v, extent_s, sigma, radial, planar, partial, mode,
           slab_start, slab_width, n_slabs, vstart, vinv, dens_tab, emit_tab,
           per_voxel, voxel_density, voxel_colour, threshold, cull, row_first, row_last,
-          reach_max, band, order, out, voxels, pixels):
+          near, reach_max, band, order, out, voxels, pixels):
     """Splat ``data[z, y, x]`` into ``out`` (premultiplied RGBA), bands of ``band`` rows.
 
     ``axis`` (0, 1, 2 for x, y, z) is the slicing axis and ``slices`` its indices front to
@@ -213,7 +219,8 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
     ``cull``, voxels of value zero are never drawn and in direct mode neither are voxels of
     zero density. Pixels whose opacity has reached ``threshold`` take no more (1 turns that
     off). ``row_first[s, p]`` and ``row_last[s, p]`` bound the voxels of each row of each
-    slice that can be drawn. ``reach_max`` bounds the footprint's reach in pixels over the
+    slice that can be drawn. Voxels nearer than camera depth ``near`` are not drawn (ghosts
+    beside an eye close to a face). ``reach_max`` bounds the footprint's reach in pixels over the
     volume. ``voxels`` and ``pixels`` count, per band, the footprints drawn and the footprint
     pixels drawn.
     """
@@ -322,10 +329,17 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
                         y = origin[1] + j * spacing[1]
                         z = origin[2] + k * spacing[2]
                         row_c, col_c, depth = project(camera, height, width, x, y, z)
-                        if row_c != row_c:
-                            continue  # behind a perspective eye
-                        reach_u = extent / px / depth if perspective else extent / px
-                        reach_v = extent_v / px / depth if perspective else extent_v / px
+                        if row_c != row_c or depth < near:
+                            continue  # behind a perspective eye, or too near it
+                        reach_u = extent / px
+                        reach_v = extent_v / px
+                        if perspective:
+                            # The support's ball seen off the axis: its image is stretched by
+                            # up to 1 + r^2 (r: the image-plane radius at unit distance).
+                            r2 = ((col_c - 0.5 * width) ** 2
+                                  + (row_c - 0.5 * height) ** 2) * px * px
+                            reach_u = extent_s / px / depth * (1.0 + r2)
+                            reach_v = reach_u
                         top = max(r0, int(math.ceil(row_c - reach_v - 0.5)))
                         bottom = min(r1 - 1, int(math.floor(row_c + reach_v - 0.5)))
                         if top > bottom:
