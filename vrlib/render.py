@@ -72,7 +72,8 @@ def render(volume, view, *, method="raycast", filter="trilinear", transfer=None,
         Threads to use (default: numba's setting). The image does not depend on it.
     **options
         Options of the chosen method (:func:`method_options` lists them): for ``"splat"``,
-        ``mode`` ("sheet" or "direct") and ``footprint_resolution``; for ``"shearwarp"``,
+        ``mode`` ("sheet", "image-aligned" or "direct"), ``footprint_resolution`` and
+        ``slab_width`` (image-aligned slabs, in voxels); for ``"shearwarp"``,
         ``min_opacity``; for ``"shear3"`` and ``"shear2"``, ``intermediate`` ("auto", "float32"
         or "float64" storage of the resampled volumes).
 

@@ -27,8 +27,8 @@ FIELDS = {
 SIZES = by_profile([24, 41], [24, 41, 64])
 VIEWS = by_profile([(30, 25), (-70, 50)], [(30, 25), (-70, 50), (10, -15), (120, 80)])
 IMAGE = by_profile(96, 192)
-# Fields that vanish at the volume's faces: splatting's kernels reach past the faces, where the
-# ray caster and the reference stop, so the other fields add a boundary error to its images.
+# Fields that vanish at the volume's faces: no boundary rule enters their images, so the
+# filters are compared there without one.
 VANISHING = ["blob s=0.08", "blob s=0.2", "smooth-sphere"]
 SAVED = {("marschner-lobb", 41, 0), ("blob s=0.08", 24, 0)}  # cases kept for the image grids
 

@@ -53,17 +53,6 @@ def planar_at(extent, planar, j, ty, u):
             + ty * ((1.0 - tx) * planar[j + 1, i] + tx * planar[j + 1, i + 1]))
 
 
-@jit(inline="always")
-def footprint_at(kind, extent, extent_v, radial, planar, u, v):
-    """Footprint at plane offsets (u, v): linear in rho^2 (radial) or bilinear (planar)."""
-    if kind == RADIAL:
-        return radial_at(extent, radial, u * u + v * v)
-    j, ty = planar_row(extent_v, planar, v)
-    if j < 0:
-        return 0.0
-    return planar_at(extent, planar, j, ty, u)
-
-
 @parallel_jit
 def partial_table(kind, p0, p1, p2, radius, spacing, basis, extent_u, extent_v, extent_s,
                   nodes, weights, table):
