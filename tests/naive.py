@@ -159,6 +159,40 @@ def classified_voxel(volume, view, transfer, data, ix, iy, iz, dens, colour):
     return dens, colour
 
 
+def slanted_footprint(slant, filt, spacing, axis, origins, directions, centre, lo, hi):
+    """Perspective footprints of a separable kernel, ray by ray: each ray crosses the voxel's
+    slice plane at in-plane offsets ``(bp, bq)`` and moves ``(mp, mq)`` per unit along the
+    axis; the whole line integral from the slanted table, a stretch ``[lo, hi]`` of the ray by
+    exact quadrature between the kernel's knots (both in index units, times
+    ``h_a / |d_a|``)."""
+    from vrlib._kernels.footprint import slanted_integral
+
+    p, q = [a for a in range(3) if a != axis]
+    d_a = directions[..., axis]
+    cross = (centre[axis] - origins[..., axis]) / d_a
+    bp = (origins[..., p] + cross * directions[..., p] - centre[p]) / spacing[p]
+    bq = (origins[..., q] + cross * directions[..., q] - centre[q]) / spacing[q]
+    unit = d_a / spacing[axis]
+    mp, mq = directions[..., p] / spacing[p] / unit, directions[..., q] / spacing[q] / unit
+    scale = spacing[axis] / np.abs(d_a)
+    whole = scale * slant(bp, bq, mp, mq)
+    lo, hi = np.broadcast_to(lo, whole.shape), np.broadcast_to(hi, whole.shape)
+    with np.errstate(invalid="ignore"):
+        ends = np.sort(np.stack([(lo - cross) * unit, (hi - cross) * unit]), axis=0)
+    nodes, weights = np.polynomial.legendre.leggauss(5)
+    out = np.empty(whole.shape)
+    for index in np.ndindex(whole.shape):
+        if not hi[index] > lo[index]:
+            out[index] = 0.0
+        elif ends[0][index] <= -filt.radius and ends[1][index] >= filt.radius:
+            out[index] = whole[index]
+        else:
+            out[index] = scale[index] * slanted_integral(
+                *filt.code, float(filt.radius), bp[index], bq[index], mp[index], mq[index],
+                nodes, weights, ends[0][index], ends[1][index])
+    return out
+
+
 def splat_naive(volume, view, filt, transfer, mode, slab_width=1.0):
     """Splatting by the book: every voxel, every pixel, footprints from the same tables.
 
@@ -172,7 +206,7 @@ def splat_naive(volume, view, filt, transfer, mode, slab_width=1.0):
     ``"direct"``: each voxel composited at once, ``1 - exp(-density(f_i) FP)``, colour
     ``E(f_i)``.
     """
-    from vrlib.footprint import footprint, running_integral
+    from vrlib.footprint import footprint, running_integral, slanted
     from vrlib.view import principal_axis
 
     volume = coefficient_volume_naive(volume, filt)
@@ -181,6 +215,12 @@ def splat_naive(volume, view, filt, transfer, mode, slab_width=1.0):
     radial = filt.name == "gaussian" and np.ptp(spacing) == 0.0
     fp = footprint(filt, spacing, None if radial else view.basis)
     cumulative = running_integral(filt)
+    slant = None
+    if view.is_perspective and not radial:
+        corners = np.array(np.meshgrid(*volume.extent, indexing="ij")).reshape(3, -1).T
+        steps = (corners - view.eye) / spacing
+        slant = slanted(filt, min(float(np.abs(np.delete(steps, axis, axis=1)
+                                               / steps[:, axis:axis + 1]).max()), 4.0))
     ghost = max(math.ceil(filt.radius) - 1, 0)
     origins, directions = view.rays()
     t_in, t_out = _clip_to_box(origins, directions, volume.extent[:, 0], volume.extent[:, 1])
@@ -212,8 +252,11 @@ def splat_naive(volume, view, filt, transfer, mode, slab_width=1.0):
                   for a in range(3))
         if rim:
             lo, hi = np.maximum(lo, t_in), np.minimum(hi, t_out)
-        return fp.between(offset @ view.right, offset @ view.up, lo - t, hi - t,
-                          rho2=np.einsum("hwc,hwc->hw", offset, offset))
+        if slant is None:
+            return fp.between(offset @ view.right, offset @ view.up, lo - t, hi - t,
+                              rho2=np.einsum("hwc,hwc->hw", offset, offset))
+        return slanted_footprint(slant, filt, spacing, axis, origins, directions, centre, lo,
+                                 hi)
 
     def composite(value, length, where):
         alpha = -np.expm1(-transfer.opacity_density(value) * length)

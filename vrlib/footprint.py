@@ -34,7 +34,8 @@ from vrlib import validate
 from vrlib._kernels import footprint as _kernel
 from vrlib.filters import Gaussian, make_filter
 
-__all__ = ["Footprint", "footprint", "running_integral", "RADIAL", "PLANAR"]
+__all__ = ["Footprint", "footprint", "Slanted", "slanted", "running_integral", "RADIAL",
+           "PLANAR"]
 
 RADIAL, PLANAR = 0, 1
 
@@ -194,6 +195,94 @@ def _planar(filt, spacing, basis, resolution):
                           extent_u, extent_v, extent_s, nodes, weights, partial)
     return Footprint(PLANAR, extent_u, np.ascontiguousarray(partial[..., -1]), extent_v, partial,
                      extent_s)
+
+
+@dataclass(frozen=True)
+class Slanted:
+    """Footprints of a separable kernel for lines of any direction, in index units: the
+    view-independent table that perspective splatting reads, one ray at a time.
+
+    A line that crosses the plane of a voxel's slice (perpendicular to the slicing axis) at
+    in-plane offsets ``(bp, bq)`` from the voxel, and moves ``(mp, mq)`` in-plane per unit along
+    the axis (all in voxels), has the line integral ``int k(s) k(bp + mp s) k(bq + mq s) ds``
+    (times ``h_a / |d_a|`` in world units, for the spacing ``h_a`` and the direction's component
+    ``d_a`` along the axis).
+
+    Attributes
+    ----------
+    table : ndarray (nm, nm, nb, nb) float32
+        Indexed ``[mp, mq, bp, bq]``, slopes over ``[-slope, slope]`` and offsets over
+        ``[-reach, reach]``.
+    reach, slope : float
+    """
+
+    table: np.ndarray
+    reach: float
+    slope: float
+
+    def __call__(self, bp, bq, mp, mq):
+        """The table's interpolation, linear in each of the four arguments, as the kernel
+        reads it (slopes clamped to the table).
+
+        Examples
+        --------
+        >>> table = slanted("trilinear", 0.5)
+        >>> round(float(table(0.0, 0.0, 0.0, 0.0)), 6)    # along the axis: int tent = 1
+        1.0
+        """
+        nm, nb = self.table.shape[0], self.table.shape[2]
+        bp, bq, mp, mq = np.broadcast_arrays(*(np.asarray(v, dtype=np.float64)
+                                               for v in (bp, bq, mp, mq)))
+        x = (bp + self.reach) * ((nb - 1) / (2.0 * self.reach))
+        y = (bq + self.reach) * ((nb - 1) / (2.0 * self.reach))
+        inside = (x >= 0) & (x <= nb - 1) & (y >= 0) & (y <= nb - 1)
+        u = np.clip((mp + self.slope) * ((nm - 1) / (2.0 * self.slope)), 0.0, nm - 1.0)
+        w = np.clip((mq + self.slope) * ((nm - 1) / (2.0 * self.slope)), 0.0, nm - 1.0)
+        i, j = (np.clip(np.floor(v).astype(int), 0, nb - 2) for v in (x, y))
+        a, b = (np.clip(np.floor(v).astype(int), 0, nm - 2) for v in (u, w))
+        tx, ty, tu, tw = x - i, y - j, u - a, w - b
+        total = np.zeros(x.shape)
+        for da, fa in ((0, 1.0 - tu), (1, tu)):
+            for db, fb in ((0, 1.0 - tw), (1, tw)):
+                t = self.table
+                ma, mb = a + da, b + db
+                total += fa * fb * ((1.0 - tx) * ((1.0 - ty) * t[ma, mb, i, j]
+                                                  + ty * t[ma, mb, i, j + 1])
+                                    + tx * ((1.0 - ty) * t[ma, mb, i + 1, j]
+                                            + ty * t[ma, mb, i + 1, j + 1]))
+        return np.where(inside, total, 0.0)
+
+
+#: Grid steps of the slanted table: offsets (voxels) and slopes, each coarsened where needed
+#: to keep at most 193 offsets and 17 slopes a side (43 MB in float32).
+SLANTED_OFFSET_STEP, SLANTED_SLOPE_STEP = 1.0 / 16.0, 0.15
+
+
+@functools.lru_cache(maxsize=4)
+def _slanted(filt, slope):
+    reach = filt.radius * (1.0 + slope)
+    nb = min(2 * math.ceil(reach / SLANTED_OFFSET_STEP) + 1, 193)
+    nm = min(2 * math.ceil(slope / SLANTED_SLOPE_STEP) + 1, 17)
+    table = np.empty((nm, nm, nb, nb), np.float32)
+    nodes, weights = np.polynomial.legendre.leggauss(5)  # exact for cubic x cubic x cubic
+    _kernel.slanted_table(*filt.code, float(filt.radius), reach, slope, nodes, weights, table)
+    return Slanted(table, reach, slope)
+
+
+def slanted(filt, slope):
+    """The :class:`Slanted` table of a separable filter for slopes up to ``slope``, rounded up
+    to a quarter so that nearby views share one table (cached, four at a time).
+
+    Parameters
+    ----------
+    filt : Filter or filter name
+    slope : float
+        Largest in-plane move per unit along the slicing axis (index units) of the lines the
+        table serves, from 0 to 4; beyond about 2 the slopes' grid coarsens (17 a side).
+    """
+    filt = make_filter(filt)
+    slope = validate.finite_number("slope", slope, low=0.0, high=4.0)
+    return _slanted(filt, max(0.25, math.ceil(slope * 4.0) / 4.0))
 
 
 @functools.lru_cache(maxsize=32)

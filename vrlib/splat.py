@@ -21,9 +21,10 @@ blurs the transfer function's edges, and slabs of different shapes average diffe
 The field is the ray caster's: the lattice is extended by repeating its border samples, and
 the line integral of every kernel within its radius of a face is clipped to each ray's stretch
 inside the volume's box (partial footprint tables), so splatting converges to the same image as
-ray casting with the same filter. In perspective the radially symmetric Gaussian footprint is
-exact for every ray; a planar footprint (every other filter) is tabulated for the view's axis and
-used for every ray, off by an amount that grows with the ray's angle to the axis.
+ray casting with the same filter. In perspective every ray gets its own footprint: the radially
+symmetric Gaussian's depends only on the ray's distance from the voxel; every other filter's is
+read from a view-independent table over the ray's crossing of the voxel's slice plane and its
+slopes (:func:`vrlib.footprint.slanted`), or where clipped integrated along the ray exactly.
 
 Skips: voxels with zero value (and in direct mode zero density) are never drawn, the thesis's
 advantage on sparse data; in sheet modes neither are voxels whose neighbourhood the transfer
@@ -44,7 +45,7 @@ from vrlib import validate
 from vrlib._kernels import splat as _kernel
 from vrlib._scheduling import balanced_order
 from vrlib.arguments import refuse_gradients
-from vrlib.footprint import RADIAL, footprint, running_integral
+from vrlib.footprint import RADIAL, footprint, running_integral, slanted
 from vrlib.gradients import SLAB, gradient_volumes
 from vrlib.image import Image, RenderStats
 from vrlib.prefilter import Tally, prepared
@@ -261,6 +262,14 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
         spread = np.hypot(camera[:, 0], camera[:, 1]) / np.maximum(camera[:, 2], near)
         reach_max = fp.extent_s * (1.0 + float(spread.max()) ** 2) / (
             view.pixel_size / view.distance * near)
+    # Perspective with a planar footprint: the slanted table, for the slopes of the rays that
+    # meet the box (extreme at its corners, the eye being outside its slab along the axis).
+    slant = None
+    if view.is_perspective and fp.kind != RADIAL:
+        corners = np.array(np.meshgrid(*extent, indexing="ij")).reshape(3, -1).T - view.eye
+        steps = corners / spacing
+        slopes = np.abs(np.delete(steps, axis, axis=1) / steps[:, axis:axis + 1])
+        slant = slanted(filt, min(float(slopes.max()), 4.0))
     # Slabs of the image-aligned mode tile the box's depth range.
     slab = slab_width * float(spacing.min())
     n_slabs = max(1, math.ceil((farthest - depth) / slab))
@@ -294,7 +303,10 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
         slices, ghost, float(filt.radius), running_integral(filt), fp.kind, fp.extent, fp.extent_v or fp.extent,
         fp.extent_s, fp.sigma, fp.table if fp.kind == RADIAL else dummy1,
         fp.table if fp.kind != RADIAL else dummy2,
-        fp.partial if fp.kind != RADIAL else dummy3, _KERNEL_MODES[mode], depth, slab,
+        fp.partial if fp.kind != RADIAL else dummy3,
+        slant.table if slant else np.zeros((2, 2, 2, 2), np.float32), slant.reach if slant else 1.0,
+        slant.slope if slant else 1.0, np.array(filt.code, dtype=np.float64),
+        np.polynomial.legendre.leggauss(5), _KERNEL_MODES[mode], depth, slab,
         n_slabs, vstart, vinv, density,
         emission, per_voxel, voxel_density, voxel_colour, early_termination,
         empty_space_skipping, first, last, near if view.is_perspective else -math.inf,

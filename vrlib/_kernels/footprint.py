@@ -162,3 +162,110 @@ def radial_partial(extent, sigma, s_lo, s_hi, rho2):
     if not hi > lo:
         return 0.0
     return (math.erf(hi * scale) - math.erf(lo * scale)) / (2.0 * math.erf(chord * scale))
+
+
+@jit
+def slanted_integral(kind, p0, p1, p2, radius, bp, bq, mp, mq, nodes, weights, s_lo, s_hi):
+    """``int k(s) k(bp + mp s) k(bq + mq s) ds`` over ``[s_lo, s_hi]`` (index units): the
+    line integral of the separable kernel along a line that crosses the voxel's slice plane at
+    in-plane offsets ``(bp, bq)`` and moves ``(mp, mq)`` in-plane per unit along the slicing
+    axis ``s``. Cut where any factor has a knot (integers and half-integers within
+    ``radius``), each piece by Gauss-Legendre ``nodes``/``weights`` (5 are exact for the
+    piecewise cubics)."""
+    reach = int(math.ceil(radius))
+    lo = max(-radius, s_lo)
+    hi = min(radius, s_hi)
+    # The stretch where every factor can be non-zero.
+    for b, m in ((bp, mp), (bq, mq)):
+        if m == 0.0:
+            if not abs(b) < radius:
+                return 0.0
+            continue
+        a = (-radius - b) / m
+        e = (radius - b) / m
+        if a > e:
+            a, e = e, a
+        lo = max(lo, a)
+        hi = min(hi, e)
+    if not hi > lo:
+        return 0.0
+    n_knots = 4 * reach + 1
+    cuts = np.empty(3 * n_knots + 2)
+    cuts[0] = lo
+    cuts[1] = hi
+    count = 2
+    for n in range(n_knots):
+        knot = (n - 2 * reach) * 0.5
+        if lo < knot < hi:
+            cuts[count] = knot
+            count += 1
+        for b, m in ((bp, mp), (bq, mq)):
+            if m != 0.0:
+                t = (knot - b) / m
+                if lo < t < hi:
+                    cuts[count] = t
+                    count += 1
+    cuts[:count].sort()
+    total = 0.0
+    for c in range(count - 1):
+        half = 0.5 * (cuts[c + 1] - cuts[c])
+        mid = 0.5 * (cuts[c + 1] + cuts[c])
+        for g in range(nodes.shape[0]):
+            s = mid + half * nodes[g]
+            total += (weights[g] * half * weight(kind, p0, p1, p2, s)
+                      * weight(kind, p0, p1, p2, bp + mp * s)
+                      * weight(kind, p0, p1, p2, bq + mq * s))
+    return total
+
+
+@parallel_jit
+def slanted_table(kind, p0, p1, p2, radius, reach, slope, nodes, weights, table):
+    """:func:`slanted_integral` on a grid: ``table[a, b, i, j]`` at slopes ``(mp, mq)`` over
+    ``[-slope, slope]`` (indices ``a``, ``b``) and offsets ``(bp, bq)`` over
+    ``[-reach, reach]`` (``i``, ``j``)."""
+    nm = table.shape[0]
+    nb = table.shape[2]
+    for ab in prange(nm * nm):
+        a = ab // nm
+        b = ab % nm
+        mp = -slope + 2.0 * slope * a / (nm - 1)
+        mq = -slope + 2.0 * slope * b / (nm - 1)
+        for i in range(nb):
+            bp = -reach + 2.0 * reach * i / (nb - 1)
+            for j in range(nb):
+                bq = -reach + 2.0 * reach * j / (nb - 1)
+                table[a, b, i, j] = slanted_integral(kind, p0, p1, p2, radius, bp, bq, mp, mq,
+                                                     nodes, weights, -radius, radius)
+
+
+@jit(inline="always")
+def slanted_at(table, reach, slope, bp, bq, mp, mq):
+    """The slanted table (:func:`slanted_table`) at offsets ``(bp, bq)`` and slopes
+    ``(mp, mq)``: linear in each of the four (slopes clamped to the table)."""
+    nm = table.shape[0]
+    nb = table.shape[2]
+    x = (bp + reach) * ((nb - 1) / (2.0 * reach))
+    y = (bq + reach) * ((nb - 1) / (2.0 * reach))
+    if not (x >= 0.0 and x <= nb - 1 and y >= 0.0 and y <= nb - 1):
+        return 0.0
+    i = min(int(x), nb - 2)
+    j = min(int(y), nb - 2)
+    tx = x - i
+    ty = y - j
+    u = min(max((mp + slope) * ((nm - 1) / (2.0 * slope)), 0.0), nm - 1.0)
+    w = min(max((mq + slope) * ((nm - 1) / (2.0 * slope)), 0.0), nm - 1.0)
+    a = min(int(u), nm - 2)
+    b = min(int(w), nm - 2)
+    tu = u - a
+    tw = w - b
+    total = 0.0
+    for da in range(2):
+        fa = tu if da == 1 else 1.0 - tu
+        for db in range(2):
+            fb = tw if db == 1 else 1.0 - tw
+            total += fa * fb * (
+                (1.0 - tx) * ((1.0 - ty) * table[a + da, b + db, i, j]
+                              + ty * table[a + da, b + db, i, j + 1])
+                + tx * ((1.0 - ty) * table[a + da, b + db, i + 1, j]
+                        + ty * table[a + da, b + db, i + 1, j + 1]))
+    return total

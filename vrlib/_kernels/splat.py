@@ -45,6 +45,8 @@ from vrlib._kernels.footprint import (
     planar_row,
     radial_at,
     radial_partial,
+    slanted_at,
+    slanted_integral,
 )
 from vrlib._kernels.tables import interpolate, interpolate_channel
 
@@ -195,9 +197,40 @@ def _clipped(fkind, extent, extent_v, extent_s, sigma, radial, planar, partial, 
             - partial_at(partial, extent_s, j, i, ty, tx, s_lo))
 
 
+@jit
+def _slanted(table, reach, slope, kind, p0, p1, p2, radius, nodes, weights, o, d, vx, vy, vz,
+             spacing, axis, pa, qa, lo, hi):
+    """Perspective footprint of a separable kernel for the ray ``o + t d`` itself: from the
+    slanted table (:class:`vrlib.footprint.Slanted`) when the whole line integral counts, by
+    exact quadrature over ``[lo, hi]`` along the ray when it is clipped."""
+    voxel = (vx, vy, vz)
+    da = d[axis]
+    if da == 0.0 or not hi > lo:
+        return 0.0
+    # Where the ray crosses the voxel's slice plane, and how it moves per unit along the axis.
+    cross = (voxel[axis] - o[axis]) / da
+    bp = (o[pa] + cross * d[pa] - voxel[pa]) / spacing[pa]
+    bq = (o[qa] + cross * d[qa] - voxel[qa]) / spacing[qa]
+    unit = da / spacing[axis]
+    mp = d[pa] / spacing[pa] / unit
+    mq = d[qa] / spacing[qa] / unit
+    # The stretch [lo, hi] of the ray in axis units from the slice plane.
+    a = (lo - cross) * unit
+    e = (hi - cross) * unit
+    if a > e:
+        a, e = e, a
+    if a <= -radius and e >= radius:
+        return spacing[axis] / abs(da) * slanted_at(table, reach, slope, bp, bq, mp, mq)
+    if not e > a:
+        return 0.0
+    return spacing[axis] / abs(da) * slanted_integral(kind, p0, p1, p2, radius, bp, bq, mp, mq,
+                                                      nodes, weights, a, e)
+
+
 @parallel_jit
 def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, radius,
-          cumulative, fkind, extent, extent_v, extent_s, sigma, radial, planar, partial, mode,
+          cumulative, fkind, extent, extent_v, extent_s, sigma, radial, planar, partial,
+          slanted, slanted_reach, slanted_slope, fcode, gauss, mode,
           slab_start, slab_width, n_slabs, vstart, vinv, dens_tab, emit_tab,
           per_voxel, voxel_density, voxel_colour, threshold, cull, row_first, row_last,
           near, reach_max, band, order, out, voxels, pixels):
@@ -207,7 +240,10 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
     back, ``ghost`` slices beyond each face included: the lattice is extended by repeating its
     border samples (as every renderer reconstructs), so that the field inside the box is the
     ray caster's. ``cumulative`` tabulates ``int k`` over ``[-radius, radius]`` (the 1-D
-    kernel's running integral). Footprints are ``fkind`` tables (:mod:`vrlib.footprint`) reaching ``extent``
+    kernel's running integral). A perspective camera reads planar filters' footprints ray by
+    ray from the ``slanted`` table (offsets to ``slanted_reach``, slopes to
+    ``slanted_slope``), or where clipped integrate the kernel (``fcode``: kind and parameters)
+    along the ray with the Gauss-Legendre rule ``gauss`` (nodes, weights). Footprints are ``fkind`` tables (:mod:`vrlib.footprint`) reaching ``extent``
     (along the image's right), ``extent_v`` (up) and ``extent_s`` (along the line) world
     units; a voxel within the filter's ``radius`` (voxels) of a face has its line integrals
     clipped to the stretch of each ray inside the box (``partial`` table, or ``sigma`` for the
@@ -380,6 +416,7 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
                                         rho2 = ox_ * ox_ + oy_ * oy_ + oz_ * oz_
                                         cosine = d[0] * fwd[0] + d[1] * fwd[1] + d[2] * fwd[2]
                                     else:
+                                        o, d = (0.0, 0.0, 0.0), fwd
                                         t = depth
                                         v = (row_c - r - 0.5) * px
                                         u = (c + 0.5 - col_c) * px
@@ -390,9 +427,15 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
                                     if mode == IMAGE:
                                         lo = max(lo, z_lo / cosine)
                                         hi = min(hi, z_hi / cosine)
-                                    fp = _clipped(fkind, extent, extent_v, extent_s, sigma,
-                                                  radial, planar, partial, u, v, rho2,
-                                                  lo - t, hi - t)
+                                    if perspective and fkind != RADIAL:
+                                        fp = _slanted(slanted, slanted_reach, slanted_slope,
+                                                      fcode[0], fcode[1], fcode[2], fcode[3],
+                                                      radius, gauss[0], gauss[1], o, d, x,
+                                                      y, z, spacing, axis, pa, qa, lo, hi)
+                                    else:
+                                        fp = _clipped(fkind, extent, extent_v, extent_s,
+                                                      sigma, radial, planar, partial, u, v,
+                                                      rho2, lo - t, hi - t)
                                     if fp != 0.0:
                                         drawn += 1
                                         _deposit(mode, f, fp, dens, er, eg, eb, threshold,
