@@ -189,7 +189,7 @@ def slanted_footprint(slant, filt, spacing, axis, origins, directions, centre, l
         else:
             out[index] = scale[index] * slanted_integral(
                 *filt.code, float(filt.radius), bp[index], bq[index], mp[index], mq[index],
-                nodes, weights, ends[0][index], ends[1][index])
+                nodes, weights, ends[0][index], ends[1][index], np.empty(64))
     return out
 
 

@@ -76,6 +76,56 @@ def test_footprint_mass_and_resolution(name):
     assert errors[0] > errors[1] > errors[2]
 
 
+@pytest.mark.parametrize("name", ["box", "trilinear", "catmull-rom", "bspline", "mitchell"])
+def test_slanted_footprints_match_line_integrals(name):
+    """The slanted table (perspective footprints, one per ray) holds the line integral of the
+    separable kernel along lines of any slope: exact quadrature between knots matches scipy's
+    to 1e-9 on random stretches, and the table's interpolation stays within 0.6% of the
+    footprint's peak (offsets every 1/16 voxel, slopes every 0.15)."""
+    from vrlib._kernels.footprint import slanted_integral
+    from vrlib.footprint import slanted
+
+    filt = vrlib.make_filter(name)
+    table = slanted(filt, 0.8)
+    nodes, weights = np.polynomial.legendre.leggauss(5)
+    rng = np.random.default_rng(1)
+    r = filt.radius
+    knots = list(np.arange(-r, r + 0.25, 0.5))
+    for _ in range(12):
+        (bp, bq), (mp, mq) = rng.uniform(-1.5, 1.5, 2), rng.uniform(-0.8, 0.8, 2)
+        lo, hi = np.sort(rng.uniform(-r - 0.5, r + 0.5, 2))
+
+        def line(s, bp=bp, bq=bq, mp=mp, mq=mq):
+            return float(filt(s) * filt(bp + mp * s) * filt(bq + mq * s))
+        cuts = sorted({lo, hi, *[k for k in knots if lo < k < hi],
+                       *[(k - b) / m for k in knots for b, m in ((bp, mp), (bq, mq))
+                         if m != 0 and lo < (k - b) / m < hi]})
+        exact = sum(integrate.quad(line, a, b)[0] for a, b in zip(cuts[:-1], cuts[1:]))
+        assert slanted_integral(*filt.code, float(r), bp, bq, mp, mq, nodes, weights, lo,
+                                hi, np.empty(64)) == pytest.approx(exact, abs=1e-9)
+        whole = sum(integrate.quad(line, a, b)[0] for a, b in zip(knots[:-1], knots[1:]))
+        assert float(table(bp, bq, mp, mq)) == pytest.approx(whole, abs=6e-3 * float(
+            table(0.0, 0.0, 0.0, 0.0)))
+
+
+@pytest.mark.parametrize("filt", ["trilinear", "catmull-rom"])
+def test_wide_perspective_as_accurate_as_ray_casting(filt):
+    """Eye just outside the bounding sphere, 100-degree field of view (rays up to 50 degrees
+    off the axis): each ray reads its own footprint, so splatting stays within the ray
+    caster's error plus 1e-3 in every mode (measured at 32^3, 48^2: Catmull-Rom 7.7e-4
+    sheet and direct, 1.2e-4 image-aligned against 3.8e-4 for the ray caster; the view-axis
+    table was off by 0.017)."""
+    field = data_gen.make_field("gaussian-blob", sigma=0.3, center=(0.05, -0.1, 0.08))
+    vol = field.sample(24)
+    view = View.orbit(azimuth=30, elevation=20, size=32, projection="perspective",
+                      distance=1.05 * np.sqrt(3.0), fov=100)
+    exact = exact_blob_image(field, view, 2.0)
+    cast = metrics.max_abs_error(render(vol, view, filter=filt, transfer=Glow(2.0)).alpha, exact)
+    for mode in vrlib.splat.MODES:
+        img = render(vol, view, method="splat", filter=filt, mode=mode, transfer=Glow(2.0))
+        assert metrics.max_abs_error(img.alpha, exact) < cast + 1e-3
+
+
 def small_volume():
     return data_gen.make_field("random-blobs", count=4, seed=2).sample((5, 6, 7))
 

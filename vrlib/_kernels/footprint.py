@@ -165,13 +165,14 @@ def radial_partial(extent, sigma, s_lo, s_hi, rho2):
 
 
 @jit
-def slanted_integral(kind, p0, p1, p2, radius, bp, bq, mp, mq, nodes, weights, s_lo, s_hi):
+def slanted_integral(kind, p0, p1, p2, radius, bp, bq, mp, mq, nodes, weights, s_lo, s_hi,
+                     cuts):
     """``int k(s) k(bp + mp s) k(bq + mq s) ds`` over ``[s_lo, s_hi]`` (index units): the
     line integral of the separable kernel along a line that crosses the voxel's slice plane at
     in-plane offsets ``(bp, bq)`` and moves ``(mp, mq)`` in-plane per unit along the slicing
     axis ``s``. Cut where any factor has a knot (integers and half-integers within
     ``radius``), each piece by Gauss-Legendre ``nodes``/``weights`` (5 are exact for the
-    piecewise cubics)."""
+    piecewise cubics); ``cuts`` is scratch space for ``12 ceil(radius) + 5`` numbers."""
     reach = int(math.ceil(radius))
     lo = max(-radius, s_lo)
     hi = min(radius, s_hi)
@@ -190,7 +191,6 @@ def slanted_integral(kind, p0, p1, p2, radius, bp, bq, mp, mq, nodes, weights, s
     if not hi > lo:
         return 0.0
     n_knots = 4 * reach + 1
-    cuts = np.empty(3 * n_knots + 2)
     cuts[0] = lo
     cuts[1] = hi
     count = 2
@@ -230,12 +230,13 @@ def slanted_table(kind, p0, p1, p2, radius, reach, slope, nodes, weights, table)
         b = ab % nm
         mp = -slope + 2.0 * slope * a / (nm - 1)
         mq = -slope + 2.0 * slope * b / (nm - 1)
+        cuts = np.empty(12 * int(math.ceil(radius)) + 5)
         for i in range(nb):
             bp = -reach + 2.0 * reach * i / (nb - 1)
             for j in range(nb):
                 bq = -reach + 2.0 * reach * j / (nb - 1)
                 table[a, b, i, j] = slanted_integral(kind, p0, p1, p2, radius, bp, bq, mp, mq,
-                                                     nodes, weights, -radius, radius)
+                                                     nodes, weights, -radius, radius, cuts)
 
 
 @jit(inline="always")

@@ -197,9 +197,36 @@ def _clipped(fkind, extent, extent_v, extent_s, sigma, radial, planar, partial, 
             - partial_at(partial, extent_s, j, i, ty, tx, s_lo))
 
 
-@jit
-def _slanted(table, reach, slope, kind, p0, p1, p2, radius, nodes, weights, o, d, vx, vy, vz,
-             spacing, axis, pa, qa, lo, hi):
+@jit(inline="always")
+def _support_image(camera, height, width, x, y, z, hx, hy, hz, row_c, col_c, depth, extent_s):
+    """Rows and columns ``(row_lo, row_hi, col_lo, col_hi)`` spanned by the image of the box
+    ``(x, y, z) +- (hx, hy, hz)`` in perspective: its corners' projections, or where a corner
+    lies behind the eye the image of the bounding ball, stretched by up to ``1 + r^2`` off
+    the axis (``r`` the image-plane radius at unit distance)."""
+    row_lo = math.inf
+    row_hi = -math.inf
+    col_lo = math.inf
+    col_hi = -math.inf
+    for corner in range(8):
+        cx = x + (hx if corner & 1 else -hx)
+        cy = y + (hy if corner & 2 else -hy)
+        cz = z + (hz if corner & 4 else -hz)
+        row, col, corner_depth = project(camera, height, width, cx, cy, cz)
+        if not corner_depth > 0.0:
+            px = camera[PIXEL]
+            r2 = ((col_c - 0.5 * width) ** 2 + (row_c - 0.5 * height) ** 2) * px * px
+            reach = extent_s / px / depth * (1.0 + r2)
+            return row_c - reach, row_c + reach, col_c - reach, col_c + reach
+        row_lo = min(row_lo, row)
+        row_hi = max(row_hi, row)
+        col_lo = min(col_lo, col)
+        col_hi = max(col_hi, col)
+    return row_lo, row_hi, col_lo, col_hi
+
+
+@jit(inline="always")
+def _slanted(table, reach, slope, kind, p0, p1, p2, radius, nodes, weights, cuts, o, d, vx,
+             vy, vz, spacing, axis, pa, qa, lo, hi):
     """Perspective footprint of a separable kernel for the ray ``o + t d`` itself: from the
     slanted table (:class:`vrlib.footprint.Slanted`) when the whole line integral counts, by
     exact quadrature over ``[lo, hi]`` along the ray when it is clipped."""
@@ -221,10 +248,8 @@ def _slanted(table, reach, slope, kind, p0, p1, p2, radius, nodes, weights, o, d
         a, e = e, a
     if a <= -radius and e >= radius:
         return spacing[axis] / abs(da) * slanted_at(table, reach, slope, bp, bq, mp, mq)
-    if not e > a:
-        return 0.0
     return spacing[axis] / abs(da) * slanted_integral(kind, p0, p1, p2, radius, bp, bq, mp, mq,
-                                                      nodes, weights, a, e)
+                                                      nodes, weights, a, e, cuts)
 
 
 @parallel_jit
@@ -279,6 +304,7 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
     q_lo = min(dq * -ghost, dq * (nq - 1 + ghost))
     q_hi = max(dq * -ghost, dq * (nq - 1 + ghost))
     reach_depth = 2.0 * extent_s if perspective else extent_s
+    widened = radius + 2.0 * slanted_reach / (slanted.shape[2] - 1)
     passes = n_slabs if mode == IMAGE else slices.shape[0]
     for it in prange(order.shape[0]):
         b = order[it]
@@ -289,15 +315,28 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
         opaque = np.zeros((r1 - r0, width), dtype=np.bool_)  # out[.., 3] >= threshold
         # Each ray's stretch inside the box; the share of it held in the sheet and the
         # length the last composited sheet stood for.
+        # Per pixel, also where the ray enters and leaves the box along the slicing axis, its
+        # direction's component along that axis, and its cosine with the view's axis.
         t_in = np.empty((r1 - r0, width))
         t_out = np.empty((r1 - r0, width))
+        enter = np.empty((r1 - r0, width))
+        leave = np.empty((r1 - r0, width))
+        along = np.empty((r1 - r0, width))
+        cosines = np.empty((r1 - r0, width))
         held_length = np.zeros((r1 - r0, width))
         last_length = np.zeros((r1 - r0, width))
+        cuts = np.empty(12 * int(math.ceil(radius)) + 5)  # scratch of the exact footprints
         for r in range(r0, r1):
             for c in range(width):
                 opaque[r - r0, c] = out[r, c, 3] >= threshold
                 o, d = pixel_ray(camera, height, width, r, c)
-                t_in[r - r0, c], t_out[r - r0, c] = ray_box(o, d, lo_box, hi_box)
+                a, e = ray_box(o, d, lo_box, hi_box)
+                t_in[r - r0, c] = a
+                t_out[r - r0, c] = e
+                enter[r - r0, c] = o[axis] + a * d[axis]
+                leave[r - r0, c] = o[axis] + e * d[axis]
+                along[r - r0, c] = d[axis]
+                cosines[r - r0, c] = d[0] * fwd[0] + d[1] * fwd[1] + d[2] * fwd[2]
         drawn = 0
         counted = 0
         qx = spacing[0] if qa == 0 else 0.0
@@ -367,21 +406,25 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
                         row_c, col_c, depth = project(camera, height, width, x, y, z)
                         if row_c != row_c or depth < near:
                             continue  # behind a perspective eye, or too near it
-                        reach_u = extent / px
-                        reach_v = extent_v / px
+                        # The footprint's pixels: those whose centres fall within the image of
+                        # the kernel's support (in perspective, of its box's corners).
+                        row_lo = row_c - extent_v / px
+                        row_hi = row_c + extent_v / px
+                        col_lo = col_c - extent / px
+                        col_hi = col_c + extent / px
                         if perspective:
-                            # The support's ball seen off the axis: its image is stretched by
-                            # up to 1 + r^2 (r: the image-plane radius at unit distance).
-                            r2 = ((col_c - 0.5 * width) ** 2
-                                  + (row_c - 0.5 * height) ** 2) * px * px
-                            reach_u = extent_s / px / depth * (1.0 + r2)
-                            reach_v = reach_u
-                        top = max(r0, int(math.ceil(row_c - reach_v - 0.5)))
-                        bottom = min(r1 - 1, int(math.floor(row_c + reach_v - 0.5)))
+                            # (widened by a step of the slanted table, whose interpolation
+                            # reaches that far past the support)
+                            row_lo, row_hi, col_lo, col_hi = _support_image(
+                                camera, height, width, x, y, z, widened * spacing[0],
+                                widened * spacing[1], widened * spacing[2], row_c, col_c,
+                                depth, extent_s)
+                        top = max(r0, int(math.ceil(row_lo - 0.5)))
+                        bottom = min(r1 - 1, int(math.floor(row_hi - 0.5)))
                         if top > bottom:
                             continue
-                        left = max(0, int(math.ceil(col_c - reach_u - 0.5)))
-                        right = min(width - 1, int(math.floor(col_c + reach_u - 0.5)))
+                        left = max(0, int(math.ceil(col_lo - 0.5)))
+                        right = min(width - 1, int(math.floor(col_hi - 0.5)))
                         if left > right:
                             continue
                         # Clipped: within the filter's radius of a face, or split into slabs.
@@ -405,37 +448,35 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
                                 for c in range(left, right + 1):
                                     if opaque[r - r0, c]:
                                         continue
-                                    if perspective:
-                                        o, d = pixel_ray(camera, height, width, r, c)
-                                        wx, wy, wz = x - o[0], y - o[1], z - o[2]
-                                        t = wx * d[0] + wy * d[1] + wz * d[2]
-                                        # Ray point minus voxel, perpendicular to the ray.
-                                        ox_, oy_, oz_ = (t * d[0] - wx, t * d[1] - wy,
-                                                         t * d[2] - wz)
-                                        u, v = on_plane(camera, ox_, oy_, oz_)
-                                        rho2 = ox_ * ox_ + oy_ * oy_ + oz_ * oz_
-                                        cosine = d[0] * fwd[0] + d[1] * fwd[1] + d[2] * fwd[2]
-                                    else:
-                                        o, d = (0.0, 0.0, 0.0), fwd
-                                        t = depth
-                                        v = (row_c - r - 0.5) * px
-                                        u = (c + 0.5 - col_c) * px
-                                        rho2 = u * u + v * v
-                                        cosine = 1.0
                                     lo = t_in[r - r0, c] if clipped else -math.inf
                                     hi = t_out[r - r0, c] if clipped else math.inf
                                     if mode == IMAGE:
-                                        lo = max(lo, z_lo / cosine)
-                                        hi = min(hi, z_hi / cosine)
-                                    if perspective and fkind != RADIAL:
-                                        fp = _slanted(slanted, slanted_reach, slanted_slope,
-                                                      fcode[0], fcode[1], fcode[2], fcode[3],
-                                                      radius, gauss[0], gauss[1], o, d, x,
-                                                      y, z, spacing, axis, pa, qa, lo, hi)
+                                        lo = max(lo, z_lo / cosines[r - r0, c])
+                                        hi = min(hi, z_hi / cosines[r - r0, c])
+                                    if perspective:
+                                        o, d = pixel_ray(camera, height, width, r, c)
+                                        if fkind != RADIAL:
+                                            fp = _slanted(slanted, slanted_reach, slanted_slope,
+                                                          fcode[0], fcode[1], fcode[2],
+                                                          fcode[3], radius, gauss[0],
+                                                          gauss[1], cuts, o, d, x, y, z,
+                                                          spacing, axis, pa, qa, lo, hi)
+                                        else:
+                                            # Ray point minus voxel, across the ray: its
+                                            # length is all the radial footprint needs.
+                                            wx, wy, wz = x - o[0], y - o[1], z - o[2]
+                                            t = wx * d[0] + wy * d[1] + wz * d[2]
+                                            rho2 = ((t * d[0] - wx) ** 2 + (t * d[1] - wy) ** 2
+                                                    + (t * d[2] - wz) ** 2)
+                                            fp = _clipped(fkind, extent, extent_v, extent_s,
+                                                          sigma, radial, planar, partial, 0.0,
+                                                          0.0, rho2, lo - t, hi - t)
                                     else:
-                                        fp = _clipped(fkind, extent, extent_v, extent_s,
-                                                      sigma, radial, planar, partial, u, v,
-                                                      rho2, lo - t, hi - t)
+                                        v = (row_c - r - 0.5) * px
+                                        u = (c + 0.5 - col_c) * px
+                                        fp = _clipped(fkind, extent, extent_v, extent_s, sigma,
+                                                      radial, planar, partial, u, v,
+                                                      u * u + v * v, lo - depth, hi - depth)
                                     if fp != 0.0:
                                         drawn += 1
                                         _deposit(mode, f, fp, dens, er, eg, eb, threshold,
@@ -479,11 +520,11 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
                 for c in range(width):
                     if not touched[r - r0, c]:
                         continue
-                    o, d = pixel_ray(camera, height, width, r, c)
                     a = t_in[r - r0, c]
                     e = t_out[r - r0, c]
+                    direction = along[r - r0, c]
                     if mode == IMAGE:
-                        cosine = d[0] * fwd[0] + d[1] * fwd[1] + d[2] * fwd[2]
+                        cosine = cosines[r - r0, c]
                         stretch = min(e, z_hi / cosine) - max(a, z_lo / cosine)
                         if stretch > 0.0:
                             held_length[r - r0, c] += stretch
@@ -493,16 +534,16 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
                             continue
                         held_length[r - r0, c] = 0.0
                     else:
-                        if d[axis] != 0.0 and e > a:
+                        if direction != 0.0 and e > a:
                             centre = origin[axis] + s * spacing[axis]
-                            share = spacing[axis] / d[axis] * (
+                            share = spacing[axis] / direction * (
                                 cumulated(cumulative, radius,
-                                          (o[axis] + e * d[axis] - centre) / spacing[axis])
+                                          (leave[r - r0, c] - centre) / spacing[axis])
                                 - cumulated(cumulative, radius,
-                                            (o[axis] + a * d[axis] - centre) / spacing[axis]))
+                                            (enter[r - r0, c] - centre) / spacing[axis]))
                             held_length[r - r0, c] += share
                         length = held_length[r - r0, c]
-                        slab = spacing[axis] / abs(d[axis])
+                        slab = spacing[axis] / abs(direction)
                         if not length >= 0.25 * slab:
                             if pass_index < passes - 1:
                                 continue
