@@ -19,7 +19,7 @@ def main():
     lit = vrlib.Glow(1.0, shading=vrlib.Phong())
     # The first tests need the ray caster and the splatter: the session compiles the first,
     # this process the second, then what later tests need.
-    calls = [("splat", "trilinear", None)]
+    calls = [("splat", "trilinear", None), ("splat-perspective", "trilinear", None)]
     calls += [(m, f, t) for m in ("shear3", "shear2", "shearwarp") for f, t in
               [("catmull-rom", None), ("catmull-rom", lit), ("omoms", None)]]
     calls += [("classified", "trilinear", lit), ("classified", "trilinear", None)]
@@ -31,6 +31,9 @@ def main():
             try:
                 if method == "classified":
                     vrlib.classify(volume, transfer).render(view)
+                elif method == "splat-perspective":  # the slanted footprints' tables
+                    vrlib.render(volume, vrlib.View.orbit(size=8, projection="perspective"),
+                                 method="splat", filter=filt)
                 else:
                     vrlib.render(volume, view, method=method, filter=filt, transfer=transfer,
                                  **({"mode": "direct"} if method == "splat" and transfer

@@ -59,8 +59,8 @@ class Footprint:
     partial : ndarray or None
         Planar: ``partial[j, i, m]``, the line integral from the support's start to ``s_m``
         (``s`` over ``[-extent_s, extent_s]`` along the view, from the point of the line
-        nearest the voxel), on the table's ``(v, u)`` grid; the last entry is the whole
-        footprint. Clipped footprints (a line that leaves the volume inside the kernel's
+        nearest the voxel), on a ``(v, u)`` grid over the same extents (at most 129 a side);
+        the last entry is the whole footprint. Clipped footprints (a line that leaves the volume inside the kernel's
         support, or a slab of the line) are differences of two entries.
     extent_s : float
         Reach of the support along the line.
@@ -190,11 +190,19 @@ def _planar(filt, spacing, basis, resolution):
     extent_v = filt.radius * float(np.abs(up) @ h)
     extent_s = filt.radius * float(np.linalg.norm(h))
     nodes, weights = np.polynomial.legendre.leggauss(6)  # stretches are under 0.11 h long
-    partial = np.empty((resolution, resolution, resolution // 2 + 1))
-    _kernel.partial_table(*filt.code, float(filt.radius), h, np.ascontiguousarray(basis).ravel(),
-                          extent_u, extent_v, extent_s, nodes, weights, partial)
-    return Footprint(PLANAR, extent_u, np.ascontiguousarray(partial[..., -1]), extent_v, partial,
-                     extent_s)
+
+    def build(entries, stretches):
+        table = np.empty((entries, entries, stretches + 1))
+        _kernel.partial_table(*filt.code, float(filt.radius), h,
+                              np.ascontiguousarray(basis).ravel(), extent_u, extent_v, extent_s,
+                              nodes, weights, table)
+        return table
+
+    # The partial table (clipped footprints) stops at 129 x 129 x 65 (8.6 MB); a finer whole
+    # footprint is built on its own grid.
+    partial = build(min(resolution, 129), min(resolution // 2, 64))
+    whole = partial[..., -1] if resolution <= 129 else build(resolution, 1)[..., -1]
+    return Footprint(PLANAR, extent_u, np.ascontiguousarray(whole), extent_v, partial, extent_s)
 
 
 @dataclass(frozen=True)
