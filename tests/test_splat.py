@@ -100,10 +100,12 @@ def test_slanted_footprints_match_line_integrals(name):
         cuts = sorted({lo, hi, *[k for k in knots if lo < k < hi],
                        *[(k - b) / m for k in knots for b, m in ((bp, mp), (bq, mq))
                          if m != 0 and lo < (k - b) / m < hi]})
-        exact = sum(integrate.quad(line, a, b)[0] for a, b in zip(cuts[:-1], cuts[1:]))
+        exact = sum(integrate.quad(line, a, b)[0]
+                    for a, b in zip(cuts[:-1], cuts[1:], strict=True))
         assert slanted_integral(*filt.code, float(r), bp, bq, mp, mq, nodes, weights, lo,
                                 hi, np.empty(64)) == pytest.approx(exact, abs=1e-9)
-        whole = sum(integrate.quad(line, a, b)[0] for a, b in zip(knots[:-1], knots[1:]))
+        whole = sum(integrate.quad(line, a, b)[0]
+                    for a, b in zip(knots[:-1], knots[1:], strict=True))
         assert float(table(bp, bq, mp, mq)) == pytest.approx(whole, abs=6e-3 * float(
             table(0.0, 0.0, 0.0, 0.0)))
 

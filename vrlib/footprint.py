@@ -60,8 +60,9 @@ class Footprint:
         Planar: ``partial[j, i, m]``, the line integral from the support's start to ``s_m``
         (``s`` over ``[-extent_s, extent_s]`` along the view, from the point of the line
         nearest the voxel), on a ``(v, u)`` grid over the same extents (at most 129 a side);
-        the last entry is the whole footprint. Clipped footprints (a line that leaves the volume inside the kernel's
-        support, or a slab of the line) are differences of two entries.
+        the last entry is the whole footprint. Clipped footprints (a line that leaves the
+        volume inside the kernel's support, or a slab of the line) are differences of two
+        entries.
     extent_s : float
         Reach of the support along the line.
     sigma : float

@@ -299,14 +299,15 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
     pixels = np.zeros(bands, np.int64)
     dummy1, dummy2, dummy3 = np.zeros(2), np.zeros((2, 2)), np.zeros((2, 2, 2))
     _kernel.splat(
-        volume.data if mode == "direct" else marks, volume.origin, spacing, view.packed(), view.height, view.width, axis,
-        slices, ghost, float(filt.radius), running_integral(filt), fp.kind, fp.extent, fp.extent_v or fp.extent,
-        fp.extent_s, fp.sigma, fp.table if fp.kind == RADIAL else dummy1,
-        fp.table if fp.kind != RADIAL else dummy2,
-        fp.partial if fp.kind != RADIAL else dummy3,
-        slant.table if slant else np.zeros((2, 2, 2, 2), np.float32), slant.reach if slant else 1.0,
-        slant.slope if slant else 1.0, np.array(filt.code, dtype=np.float64),
-        np.polynomial.legendre.leggauss(5), _KERNEL_MODES[mode], depth, slab,
+        volume.data if mode == "direct" else marks, volume.origin, spacing, view.packed(),
+        view.height, view.width, axis, slices, ghost, float(filt.radius),
+        running_integral(filt), fp.kind, fp.extent, fp.extent_v or fp.extent, fp.extent_s,
+        fp.sigma, fp.table if fp.kind == RADIAL else dummy1,
+        fp.table if fp.kind != RADIAL else dummy2, fp.partial if fp.kind != RADIAL else dummy3,
+        slant.table if slant else np.zeros((2, 2, 2, 2), np.float32),
+        slant.reach if slant else 1.0, slant.slope if slant else 1.0,
+        np.array(filt.code, dtype=np.float64), np.polynomial.legendre.leggauss(5),
+        _KERNEL_MODES[mode], depth, slab,
         n_slabs, vstart, vinv, density,
         emission, per_voxel, voxel_density, voxel_colour, early_termination,
         empty_space_skipping, first, last, near if view.is_perspective else -math.inf,

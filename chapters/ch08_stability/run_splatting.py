@@ -111,8 +111,8 @@ def footprint_angles():
             for _ in range(60):
                 o = rng.uniform(-1.5, 1.5, 3)
                 o -= (o @ d) * d
-                line = integrate.quad(lambda t, o=o: float(np.prod(filt(o + t * d))), -4, 4,
-                                      limit=200, points=[0.0])[0]
+                line = integrate.quad(lambda t, o=o, d=d, filt=filt: float(
+                    np.prod(filt(o + t * d))), -4, 4, limit=200, points=[0.0])[0]
                 worst = max(worst, abs(float(table(o @ right, o @ up)) - line))
             out.append({"filter": name, "angle": angle, "relative_error": worst / peak})
     return out

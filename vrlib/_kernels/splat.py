@@ -32,7 +32,6 @@ from vrlib._kernels.camera import (
     PIXEL,
     camera_coords,
     is_perspective,
-    on_plane,
     pixel_ray,
     project,
     ray_box,
@@ -130,7 +129,7 @@ def _deposit(mode, f, fp, dens, er, eg, eb, threshold, sheet, touched, opaque, o
     opaque[r - r0, c] = out[r, c, 3] >= threshold
 
 
-@jit(inline="always")
+@jit
 def _composite(out, r, c, value, length, vstart, vinv, dens_tab, emit_tab):
     """Composite a segment of ``length`` at the constant ``value`` (eqs 1.4, 1.7)."""
     dens = interpolate(dens_tab, vstart, vinv, value)
@@ -142,7 +141,7 @@ def _composite(out, r, c, value, length, vstart, vinv, dens_tab, emit_tab):
     out[r, c, 3] += weight
 
 
-@jit(inline="always")
+@jit
 def cumulated(cumulative, radius, x):
     """The running integral of the 1-D kernel up to ``x`` (voxels), from its table over
     ``[-radius, radius]``."""
@@ -156,7 +155,7 @@ def cumulated(cumulative, radius, x):
     return cumulative[m] + (y - m) * (cumulative[m + 1] - cumulative[m])
 
 
-@jit(inline="always")
+@jit
 def _window(base, slope, lo, hi, first, last):
     """The integers ``x`` in ``[first, last]`` with ``base + slope x`` in ``[lo, hi]``
     (``first > last`` when none), widened by one for rounding."""
@@ -175,7 +174,7 @@ def _window(base, slope, lo, hi, first, last):
     return max(first, int(math.floor(a)) - 1), min(last, int(math.ceil(b)) + 1)
 
 
-@jit(inline="always")
+@jit
 def _clipped(fkind, extent, extent_v, extent_s, sigma, radial, planar, partial, u, v, rho2,
              s_lo, s_hi):
     """The footprint at plane offsets ``(u, v)`` restricted to ``[s_lo, s_hi]`` along the line
@@ -197,7 +196,7 @@ def _clipped(fkind, extent, extent_v, extent_s, sigma, radial, planar, partial, 
             - partial_at(partial, extent_s, j, i, ty, tx, s_lo))
 
 
-@jit(inline="always")
+@jit
 def _support_image(camera, height, width, x, y, z, hx, hy, hz, row_c, col_c, depth, extent_s):
     """Rows and columns ``(row_lo, row_hi, col_lo, col_hi)`` spanned by the image of the box
     ``(x, y, z) +- (hx, hy, hz)`` in perspective: its corners' projections, or where a corner
@@ -224,7 +223,7 @@ def _support_image(camera, height, width, x, y, z, hx, hy, hz, row_c, col_c, dep
     return row_lo, row_hi, col_lo, col_hi
 
 
-@jit(inline="always")
+@jit
 def _slanted(table, reach, slope, kind, p0, p1, p2, radius, nodes, weights, cuts, o, d, vx,
              vy, vz, spacing, axis, pa, qa, lo, hi):
     """Perspective footprint of a separable kernel for the ray ``o + t d`` itself: from the
@@ -252,6 +251,70 @@ def _slanted(table, reach, slope, kind, p0, p1, p2, radius, nodes, weights, cuts
                                                       nodes, weights, a, e, cuts)
 
 
+@jit
+def _flush(mode, s, r0, r1, width, axis, origin, spacing, radius, cumulative, z_lo, z_hi,
+           slab_width, last_pass, sheet, touched, opaque, t_in, t_out, enter, leave, along,
+           cosines, held_length, last_length, out, threshold, vstart, vinv, dens_tab, emit_tab):
+    """Classify a band's sheet per pixel as one segment and composite it (eqs 1.4, 1.7), after
+    a pass of :func:`splat`: the slice ``s`` (SHEET) or the slab ``[z_lo, z_hi]`` (IMAGE).
+    Compiled apart from the parallel loop, which it would otherwise make slow to compile.
+
+    IMAGE: the segment is the slab's stretch of the ray inside the box (a stretch under a
+    quarter of the slab, where the ray enters, is held for the next slab). SHEET: the slice's
+    share of the ray inside the box, ``int k((x_a(t) - x_s) / h) dt`` over it (the shares of
+    all slices, ghosts included, sum to the stretch); a share under a quarter of a slab's
+    length (the slice near where the ray enters or leaves) is held for the next slice, and
+    what is held at the end is composited after the last one (over its own share, which may
+    be negative for kernels with negative lobes).
+    """
+    for r in range(r0, r1):
+        for c in range(width):
+            if not touched[r - r0, c]:
+                continue
+            a = t_in[r - r0, c]
+            e = t_out[r - r0, c]
+            direction = along[r - r0, c]
+            if mode == IMAGE:
+                cosine = cosines[r - r0, c]
+                stretch = min(e, z_hi / cosine) - max(a, z_lo / cosine)
+                if stretch > 0.0:
+                    held_length[r - r0, c] += stretch
+                length = held_length[r - r0, c]
+                if not (length >= 0.25 * slab_width / cosine
+                        or z_hi / cosine >= e) or not length > 0.0:
+                    continue
+                held_length[r - r0, c] = 0.0
+            else:
+                if direction != 0.0 and e > a:
+                    centre = origin[axis] + s * spacing[axis]
+                    share = spacing[axis] / direction * (
+                        cumulated(cumulative, radius,
+                                  (leave[r - r0, c] - centre) / spacing[axis])
+                        - cumulated(cumulative, radius,
+                                    (enter[r - r0, c] - centre) / spacing[axis]))
+                    held_length[r - r0, c] += share
+                length = held_length[r - r0, c]
+                slab = spacing[axis] / abs(direction)
+                if not length >= 0.25 * slab:
+                    if not last_pass:
+                        continue
+                    if not abs(length) > 1e-6 * slab:
+                        # No share to divide by: the last composited length (or the
+                        # whole stretch) stands for it.
+                        length = last_length[r - r0, c]
+                        if not length > 0.0:
+                            length = e - a
+                            if not length > 0.0:
+                                continue
+                held_length[r - r0, c] = 0.0
+                last_length[r - r0, c] = length
+            touched[r - r0, c] = False
+            value = sheet[r - r0, c] / length
+            sheet[r - r0, c] = 0.0
+            _composite(out, r, c, value, length, vstart, vinv, dens_tab, emit_tab)
+            opaque[r - r0, c] = out[r, c, 3] >= threshold
+
+
 @parallel_jit
 def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, radius,
           cumulative, fkind, extent, extent_v, extent_s, sigma, radial, planar, partial,
@@ -268,11 +331,12 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
     kernel's running integral). A perspective camera reads planar filters' footprints ray by
     ray from the ``slanted`` table (offsets to ``slanted_reach``, slopes to
     ``slanted_slope``), or where clipped integrate the kernel (``fcode``: kind and parameters)
-    along the ray with the Gauss-Legendre rule ``gauss`` (nodes, weights). Footprints are ``fkind`` tables (:mod:`vrlib.footprint`) reaching ``extent``
-    (along the image's right), ``extent_v`` (up) and ``extent_s`` (along the line) world
-    units; a voxel within the filter's ``radius`` (voxels) of a face has its line integrals
-    clipped to the stretch of each ray inside the box (``partial`` table, or ``sigma`` for the
-    radial Gaussian's closed form). ``mode``: ``SHEET`` and ``DIRECT`` walk the slices, one
+    along the ray with the Gauss-Legendre rule ``gauss`` (nodes, weights). Footprints are
+    ``fkind`` tables (:mod:`vrlib.footprint`) reaching ``extent`` (along the image's right),
+    ``extent_v`` (up) and ``extent_s`` (along the line) world units; a voxel within the
+    filter's ``radius`` (voxels) of a face has its line integrals clipped to the stretch of
+    each ray inside the box (``partial`` table, or ``sigma`` for the radial Gaussian's closed
+    form). ``mode``: ``SHEET`` and ``DIRECT`` walk the slices, one
     pass each; ``IMAGE`` walks ``n_slabs`` slabs of camera depth ``slab_width`` from
     ``slab_start``, each voxel adding the part of its line integral that lies in the slab.
     Classification reads density and emission tables over values (``vstart``, ``vinv``), or in
@@ -505,62 +569,11 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
                                         drawn += 1
                                         _deposit(mode, f, fp, dens, er, eg, eb, threshold,
                                                  sheet, touched, opaque, out, r, r0, c)
-            if mode == DIRECT:
-                continue
-            # Classify the sheet per pixel as one segment and composite it (eqs 1.4, 1.7).
-            # IMAGE: the slab's stretch of the ray inside the box (a stretch under a quarter
-            # of the slab, where the ray enters, is held for the next slab). SHEET: the slice's share of
-            # the ray inside the box, int k((x_a(t) - x_s) / h) dt over it (the shares of all
-            # slices, ghosts included, sum to the stretch); a share under a quarter of a
-            # slab's length (the slice near where the ray enters or leaves) is held for the
-            # next slice, and what is held at the end is composited after the last one (over
-            # its own share, which may be negative for kernels with negative lobes).
-            s = slices[pass_index] if mode == SHEET else 0
-            for r in range(r0, r1):
-                for c in range(width):
-                    if not touched[r - r0, c]:
-                        continue
-                    a = t_in[r - r0, c]
-                    e = t_out[r - r0, c]
-                    direction = along[r - r0, c]
-                    if mode == IMAGE:
-                        cosine = cosines[r - r0, c]
-                        stretch = min(e, z_hi / cosine) - max(a, z_lo / cosine)
-                        if stretch > 0.0:
-                            held_length[r - r0, c] += stretch
-                        length = held_length[r - r0, c]
-                        if not (length >= 0.25 * slab_width / cosine
-                                or z_hi / cosine >= e) or not length > 0.0:
-                            continue
-                        held_length[r - r0, c] = 0.0
-                    else:
-                        if direction != 0.0 and e > a:
-                            centre = origin[axis] + s * spacing[axis]
-                            share = spacing[axis] / direction * (
-                                cumulated(cumulative, radius,
-                                          (leave[r - r0, c] - centre) / spacing[axis])
-                                - cumulated(cumulative, radius,
-                                            (enter[r - r0, c] - centre) / spacing[axis]))
-                            held_length[r - r0, c] += share
-                        length = held_length[r - r0, c]
-                        slab = spacing[axis] / abs(direction)
-                        if not length >= 0.25 * slab:
-                            if pass_index < passes - 1:
-                                continue
-                            if not abs(length) > 1e-6 * slab:
-                                # No share to divide by: the last composited length (or the
-                                # whole stretch) stands for it.
-                                length = last_length[r - r0, c]
-                                if not length > 0.0:
-                                    length = e - a
-                                    if not length > 0.0:
-                                        continue
-                        held_length[r - r0, c] = 0.0
-                        last_length[r - r0, c] = length
-                    touched[r - r0, c] = False
-                    value = sheet[r - r0, c] / length
-                    sheet[r - r0, c] = 0.0
-                    _composite(out, r, c, value, length, vstart, vinv, dens_tab, emit_tab)
-                    opaque[r - r0, c] = out[r, c, 3] >= threshold
+            if mode != DIRECT:
+                last_pass = pass_index == passes - 1
+                _flush(mode, slices[pass_index], r0, r1, width, axis, origin, spacing, radius,
+                       cumulative, z_lo, z_hi, slab_width, last_pass, sheet, touched, opaque,
+                       t_in, t_out, enter, leave, along, cosines, held_length, last_length,
+                       out, threshold, vstart, vinv, dens_tab, emit_tab)
         voxels[b] = counted
         pixels[b] = drawn
