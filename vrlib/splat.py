@@ -198,10 +198,14 @@ def full_extents(volume, axis):
     return (np.zeros(shape[:2], np.int64), np.full(shape[:2], shape[2] - 1, np.int64))
 
 
+def _corners(box):
+    """The 8 corners ``(x, y, z)`` of ``box`` (``[[xmin, xmax], ...]``)."""
+    return np.array(np.meshgrid(*box, indexing="ij")).reshape(3, -1).T
+
+
 def _depths(view, box):
-    """Smallest and largest camera depth of the corners of ``box`` (``[[xmin, xmax], ...]``)."""
-    corners = np.array(np.meshgrid(*box, indexing="ij")).reshape(3, -1).T
-    depths = view.to_camera(corners)[:, 2]
+    """Smallest and largest camera depth of the corners of ``box``."""
+    depths = view.to_camera(_corners(box))[:, 2]
     return float(depths.min()), float(depths.max())
 
 
@@ -258,7 +262,7 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
     if view.is_perspective:
         # A footprint reaches (support radius / pixel at its depth) x (1 + r^2) pixels, r the
         # image-plane radius (unit distance) where it lands.
-        camera = view.to_camera(np.array(np.meshgrid(*lattice, indexing="ij")).reshape(3, -1).T)
+        camera = view.to_camera(_corners(lattice))
         spread = np.hypot(camera[:, 0], camera[:, 1]) / np.maximum(camera[:, 2], near)
         reach_max = fp.extent_s * (1.0 + float(spread.max()) ** 2) / (
             view.pixel_size / view.distance * near)
@@ -266,8 +270,7 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
     # meet the box (extreme at its corners, the eye being outside its slab along the axis).
     slant = None
     if view.is_perspective and fp.kind != RADIAL:
-        corners = np.array(np.meshgrid(*extent, indexing="ij")).reshape(3, -1).T - view.eye
-        steps = corners / spacing
+        steps = (_corners(extent) - view.eye) / spacing
         slopes = np.abs(np.delete(steps, axis, axis=1) / steps[:, axis:axis + 1])
         slant = slanted(filt, min(float(slopes.max()), 4.0))
     # Slabs of the image-aligned mode tile the box's depth range.

@@ -336,9 +336,9 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
     ``extent_v`` (up) and ``extent_s`` (along the line) world units; a voxel within the
     filter's ``radius`` (voxels) of a face has its line integrals clipped to the stretch of
     each ray inside the box (``partial`` table, or ``sigma`` for the radial Gaussian's closed
-    form). ``mode``: ``SHEET`` and ``DIRECT`` walk the slices, one
-    pass each; ``IMAGE`` walks ``n_slabs`` slabs of camera depth ``slab_width`` from
-    ``slab_start``, each voxel adding the part of its line integral that lies in the slab.
+    form). ``mode``: ``SHEET`` and ``DIRECT`` walk the slices, one pass each; ``IMAGE``
+    walks ``n_slabs`` slabs of camera depth ``slab_width`` from ``slab_start``, each voxel
+    adding the part of its line integral that lies in the slab.
     Classification reads density and emission tables over values (``vstart``, ``vinv``), or in
     direct mode with ``per_voxel`` each voxel's own ``voxel_density`` and ``voxel_colour``. With
     ``cull``, voxels of value zero are never drawn and in direct mode neither are voxels of
@@ -377,10 +377,10 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
         sheet = np.zeros((r1 - r0, width))
         touched = np.zeros((r1 - r0, width), dtype=np.bool_)
         opaque = np.zeros((r1 - r0, width), dtype=np.bool_)  # out[.., 3] >= threshold
-        # Each ray's stretch inside the box; the share of it held in the sheet and the
-        # length the last composited sheet stood for.
-        # Per pixel, also where the ray enters and leaves the box along the slicing axis, its
-        # direction's component along that axis, and its cosine with the view's axis.
+        # Per pixel: the ray's stretch inside the box, where it enters and leaves along the
+        # slicing axis, its direction's component along that axis and its cosine with the
+        # view's axis; the share of the stretch held in the sheet, and the length the last
+        # composited sheet stood for.
         t_in = np.empty((r1 - r0, width))
         t_out = np.empty((r1 - r0, width))
         enter = np.empty((r1 - r0, width))
@@ -570,8 +570,10 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
                                         _deposit(mode, f, fp, dens, er, eg, eb, threshold,
                                                  sheet, touched, opaque, out, r, r0, c)
             if mode != DIRECT:
+                # (IMAGE passes are slabs, which may outnumber the slices: no slice to name)
+                sheet_slice = slices[pass_index] if mode == SHEET else 0
                 last_pass = pass_index == passes - 1
-                _flush(mode, slices[pass_index], r0, r1, width, axis, origin, spacing, radius,
+                _flush(mode, sheet_slice, r0, r1, width, axis, origin, spacing, radius,
                        cumulative, z_lo, z_hi, slab_width, last_pass, sheet, touched, opaque,
                        t_in, t_out, enter, leave, along, cosines, held_length, last_length,
                        out, threshold, vstart, vinv, dens_tab, emit_tab)
