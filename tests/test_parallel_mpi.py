@@ -21,8 +21,16 @@ PROGRAMS = Path(__file__).parent / "mpi_programs"
 MPIEXEC = Path(sys.executable).parent / "mpiexec"
 # Every compositor with even bricks, then the other balances and the image partition.
 CASES = [[name, "even"] for name in composite.COMPOSITORS] + [
-    ["direct-send", "interleaved"], ["binary-swap", "work"], ["image", None]]
+    ["direct-send", "interleaved"], ["binary-swap", "work"], ["radix-k", "work"],
+    ["image", None]]
+# Radix-k factorisations besides the default (radix_factors), per rank count.
+FACTORS = {4: ["2x2"], 6: ["2x3", "3x2"], 8: ["2x2x2", "2x4"], 9: ["3x3"], 10: ["2x5", "5x2"],
+           12: ["3x4", "2x2x3", "2x6"]}
 TOLERANCE = 1e-6  # the issue's; measured differences are below 1e-15
+# Orthographic with the trilinear filter, perspective with Catmull-Rom (wider ghosts).
+VIEWS = [({"azimuth": 35, "elevation": 25}, "trilinear"),
+         ({"azimuth": -120, "elevation": -40, "projection": "perspective"}, "catmull-rom")]
+FAST_RANKS = (1, 3, 6, 12)
 
 
 def launch(program, ranks, *args, timeout=120):
@@ -34,6 +42,17 @@ def launch(program, ranks, *args, timeout=120):
     return done, time.perf_counter() - start
 
 
+def render(ranks, views, cases, **config):
+    """Results of ``render.py`` for each view (orbit, filter) and case."""
+    config = {"field": "marschner-lobb", "n": 25, "size": 40, "cases": cases,
+              "views": [{**v, "filter": f} for v, f in views], **config}
+    done, _ = launch("render.py", ranks, json.dumps(config))
+    assert done.returncode == 0, done.stderr
+    report = json.loads(done.stdout.strip().splitlines()[-1])
+    assert report["size"] == ranks
+    return report["results"]
+
+
 def check_results(results):
     assert results
     for r in results:
@@ -42,24 +61,20 @@ def check_results(results):
 
 
 @pytest.mark.mpi
-@pytest.mark.parametrize("ranks", [1, 2, 3, 4, 8] + [pytest.param(r, marks=pytest.mark.slow)
-                                                    for r in (5, 6, 7)])
+@pytest.mark.parametrize("ranks", [r if r in FAST_RANKS else pytest.param(
+    r, marks=pytest.mark.slow) for r in range(1, 13)])
 def test_every_rank_count_equals_the_serial_render(ranks):
-    """Object partition (binary swap, direct send, interleaved, work-balanced) and image
-    partition, orthographic and perspective, trilinear and Catmull-Rom: the composited image
-    equals the serial render's to 1e-6, so bricks join without seams. ``make test`` runs 1-4
-    ranks (a fold at 3) and 8; 5-7 run in ``make test-all`` (slow on two cores)."""
-    config = {"field": "marschner-lobb", "n": 25, "size": 40, "filters": ["trilinear",
-                                                                           "catmull-rom"],
-              "views": [{"azimuth": 35, "elevation": 25},
-                        {"azimuth": -120, "elevation": -40, "projection": "perspective"}],
-              "cases": CASES}
-    done, _ = launch("render.py", ranks, json.dumps(config))
-    assert done.returncode == 0, done.stderr
-    report = json.loads(done.stdout.strip().splitlines()[-1])
-    assert report["size"] == ranks
-    check_results(report["results"])
-    for r in report["results"]:
+    """Object partition (direct send, binary swap, radix-k with its default and other
+    factorisations, interleaved and work-balanced bricks) and image partition, orthographic
+    and perspective: the composited image equals the serial render's to 1e-6, so bricks join
+    without seams, for every rank count from 1 to 12. ``make test`` runs 1, 3, 6 and 12 (odd,
+    a fold for binary swap, two radix-k rounds of different k, a prime factor of 3); the rest
+    run in ``make test-all`` (slow on two cores)."""
+    cases = CASES + [[f"radix-k:{f}", "even"] for f in FACTORS.get(ranks, [])]
+    results = render(ranks, VIEWS, cases)
+    assert len(results) == len(cases) * len(VIEWS)
+    check_results(results)
+    for r in results:
         if ranks == 1:  # nothing to send to anyone
             assert all(sum(b.values()) == 0 for b in r["bytes"])
 
@@ -72,75 +87,127 @@ def test_shading_and_gradient_opacity_equal_the_serial_render(ranks):
     samples serve both: shaded, gradient-classified images equal the serial render to 1e-6 for
     every compositor and balance. (``make test`` checks the same on one rank of four bricks,
     in process.)"""
-    config = {"field": "marschner-lobb", "n": 25, "size": 32, "filters": ["trilinear",
-                                                                           "catmull-rom"],
-              "views": [{"azimuth": 35, "elevation": 25},
-                        {"azimuth": -120, "elevation": -40, "projection": "perspective"}],
-              "shade": True, "gradient_opacity": [[0.5, 3.0], [0.2, 1.0]], "cases": CASES}
-    done, _ = launch("render.py", ranks, json.dumps(config))
-    assert done.returncode == 0, done.stderr
-    check_results(json.loads(done.stdout.strip().splitlines()[-1])["results"])
+    check_results(render(ranks, VIEWS, CASES, size=32, shade=True,
+                         gradient_opacity=[[0.5, 3.0], [0.2, 1.0]]))
 
 
 @pytest.mark.mpi
 def test_ranks_with_nothing_to_show_take_part():
     """Zoomed in on one corner, several of 8 bricks fall off the screen: their ranks draw
     nothing, yet compositing completes and matches the serial render. Under direct send they
-    send no pixels; under binary swap they still pass on the halves their partners gave
-    them."""
-    config = {"field": "marschner-lobb", "n": 25, "size": 32, "filters": ["trilinear"],
-              "views": [{"azimuth": 5, "elevation": 5, "zoom": 6.0,
-                         "center": [0.7, 0.7, 0.7]}], "cases": CASES}
-    done, _ = launch("render.py", 8, json.dumps(config))
-    assert done.returncode == 0, done.stderr
-    results = json.loads(done.stdout.strip().splitlines()[-1])["results"]
+    send headers only (empty rectangles); under binary swap and radix-k they still pass on
+    what their partners gave them."""
+    view = {"azimuth": 5, "elevation": 5, "zoom": 6.0, "center": [0.7, 0.7, 0.7]}
+    results = render(8, [(view, "trilinear")], CASES, size=32)
     check_results(results)
     for r in results[:len(composite.COMPOSITORS)]:  # one brick per rank, cut evenly
         idle = [i for i, s in enumerate(r["samples"]) if s == 0]
         assert len(idle) >= 2, r["samples"]
         if r["compositing"] == "direct-send":
-            assert all(r["bytes"][i]["composite"] == 0 for i in idle)
+            assert all(count == 0 for i in idle for _, _, count in r["messages"][i])
 
 
 @pytest.mark.mpi
-def test_a_failing_rank_ends_the_job_with_its_error_on_rank_0():
+def test_every_message_is_bounded_by_the_simulated_one():
+    """The network simulation routes the real compositor's messages: for each compositor on 6
+    ranks (binary swap folds a pair; radix-k 2 x 3 and 3 x 2), every rectangle a rank sent in
+    a round goes to a destination the simulated round names, with at most the simulated
+    pixels (the simulation sends each brick's projected bounding rectangle, the renderer the
+    rectangle of what it drew), and the renderer sends at least half the simulated pixels in
+    all. Bytes per rank are headers plus 32 bytes per float64 RGBA pixel."""
+    ranks, n, size = 6, 25, 40
+    orbit = {"azimuth": 35, "elevation": 25}
+    cases = [[name, "even"] for name in composite.COMPOSITORS] + [
+        ["radix-k:2x3", "even"], ["radix-k:3x2", "even"]]
+    results = render(ranks, [(orbit, "trilinear")], cases)
+    view = vrlib.View.orbit(size=size, **orbit)
+    vol = data_gen.make_field("marschner-lobb").sample(n)
+    tiles = decompose.screen_tiles(size, size, ranks)
+    for r in results:
+        name, _, factors = r["compositing"].partition(":")
+        compositor = mpi.RadixK([int(f) for f in factors.split("x")]) if factors else \
+            composite.COMPOSITORS[name]
+        tree = compositor.split((n - 1,) * 3, ranks)
+        rounds = compositor.rounds(tree, np.arange(ranks), tiles, view, vol.origin,
+                                   vol.spacing, bytes_per_pixel=1)
+        simulated = {(k, int(s), int(d)): b for k, m in enumerate(rounds)
+                     for s, d, b in zip(m.src, m.dst, m.bytes, strict=True)}
+        sent = 0
+        for src, log in enumerate(r["messages"]):
+            rects = 0
+            for k, dest, count in log:
+                assert count <= simulated.get((k, src, dest), 0), (r["compositing"], k, src,
+                                                                   dest)
+                sent += count
+                rects += 1
+            assert r["bytes"][src]["composite"] == \
+                rects * composite.HEADER + 32 * sum(c for _, _, c in log)
+        assert sent >= 0.5 * sum(simulated.values()), r["compositing"]
+
+
+# Rounds of each compositor on 4 ranks (binary swap: no fold, rounds 1 and 2).
+FAILURES = [("direct-send", 2, 0, "before"), ("binary-swap", 3, 2, "after"),
+            ("radix-k:2x2", 1, 0, "after"), ("radix-k:2x2", 2, 1, "before"),
+            pytest.param("binary-swap", 1, 1, "before", marks=pytest.mark.slow),
+            pytest.param("binary-swap", 2, 2, "before", marks=pytest.mark.slow),
+            pytest.param("radix-k", 3, 0, "before", marks=pytest.mark.slow),
+            pytest.param("radix-k:2x2", 0, 1, "after", marks=pytest.mark.slow)]
+
+
+@pytest.mark.mpi
+def test_a_failing_source_ends_the_job_with_its_error_on_rank_0():
     """One rank's source raises: rank 0 reports that rank's error and mpiexec exits non-zero
     within seconds (no hang)."""
     done, seconds = launch("fail.py", 4, "2", timeout=60)
     assert done.returncode != 0
+    report = rank_0_report(done)
+    assert report["error"] == "RankFailed"
+    assert "rank 2 failed while reading its bricks: OSError" in report["message"]
+    assert seconds < 30
+
+
+def rank_0_report(done):
     line = re.search(r'\{"rank": 0, [^}]*\}', done.stdout)
     assert line, done.stdout + done.stderr
-    report = json.loads(line.group(0))
-    assert report["error"] == "RankFailed"
-    assert "rank 2" in report["message"] and "OSError" in report["message"]
+    return json.loads(line.group(0))
+
+
+@pytest.mark.mpi
+@pytest.mark.parametrize("spec,rank,round,when", FAILURES)
+def test_a_failure_inside_a_compositing_round_ends_the_job(spec, rank, round, when):
+    """A rank raises inside compositing round ``round``, before posting that round's messages
+    (its partners wait for pixels that never come) or after the round (its partners wait in
+    the next round, or for the frame's end): every rank's wait ends, rank 0 reports that
+    rank's error and the round, and mpiexec exits non-zero within seconds."""
+    done, seconds = launch("fail.py", 4, str(rank), spec, str(round), when, timeout=60)
+    assert done.returncode != 0
+    report = rank_0_report(done)
+    name = spec.split(":")[0]
+    if rank == 0:
+        assert report["error"] == "RuntimeError"
+    else:
+        assert report["error"] == "RankFailed"
+        assert f"rank {rank} failed while compositing by {name} (round {round})" in \
+            report["message"]
+    assert f"injected failure {when} round {round}" in report["message"]
     assert seconds < 30
 
 
 @pytest.mark.mpi
-def test_bytes_sent_against_the_traffic_model():
-    """Direct-send bytes per rank are at most the simulated fragments (bounding rectangles of
-    the bricks' projections, 32 bytes per float64 RGBA pixel, plus headers) and at least half
-    of them; binary swap sends at most the classic W^2 (1 - 1/P) per rank."""
-    ranks, n, size = 4, 25, 40
-    config = {"field": "marschner-lobb", "n": n, "size": size, "filters": ["trilinear"],
-              "views": [{"azimuth": 35, "elevation": 25}],
-              "cases": [["binary-swap", "even"], ["direct-send", "even"]]}
-    done, _ = launch("render.py", ranks, json.dumps(config))
+def test_a_rank_killed_by_a_signal_ends_the_job_and_writes_nothing(tmp_path):
+    """Rank 2 is killed (SIGKILL) in the second radix-k round while the others wait on it:
+    mpiexec ends the job within seconds with a non-zero status, and rank 0, which would have
+    written the image, leaves neither the image nor a temporary file behind. (The same run
+    without the kill writes the image.)"""
+    out = tmp_path / "frame.png"
+    done, seconds = launch("fail.py", 4, "2", "radix-k:2x2", "1", "kill", str(out),
+                           timeout=60)
+    assert done.returncode != 0
+    assert seconds < 30
+    assert list(tmp_path.iterdir()) == []
+    done, _ = launch("fail.py", 4, "9", "radix-k:2x2", "1", "kill", str(out), timeout=60)
     assert done.returncode == 0, done.stderr
-    swap, direct = json.loads(done.stdout.strip().splitlines()[-1])["results"]
-    assert (swap["compositing"], direct["compositing"]) == ("binary-swap", "direct-send")
-    view = vrlib.View.orbit(azimuth=35, elevation=25, size=size)
-    vol = data_gen.make_field("marschner-lobb").sample(n)
-    tree = decompose.split((n - 1,) * 3, ranks)
-    msgs = composite.COMPOSITORS["direct-send"].messages(
-        tree, np.arange(ranks), decompose.screen_tiles(size, size, ranks), view, vol.origin,
-        vol.spacing, bytes_per_pixel=32)
-    simulated = msgs.sent_per_node(ranks)
-    measured = np.array([b["composite"] for b in direct["bytes"]], dtype=float)
-    assert np.all(measured <= simulated + mpi.HEADER * 2 * ranks)
-    assert measured.sum() >= 0.5 * simulated.sum()
-    classic = size * size * 32 * (1 - 1 / ranks) + mpi.HEADER * 2 * ranks
-    assert all(b["composite"] <= classic for b in swap["bytes"])
+    assert [p.name for p in tmp_path.iterdir()] == ["frame.png"]
 
 
 # ---------------------------------------------------------------- in this process
@@ -193,6 +260,13 @@ def test_bad_arguments_name_the_parameter(tmp_path):
         mpi.render_object(comm, field, view, shape=9, compositing="tree")
     with pytest.raises(ValueError, match="binary-swap compositing needs one convex brick"):
         mpi.render_object(comm, field, view, shape=9, balance="interleaved")
+    with pytest.raises(ValueError, match="radix-k compositing needs one convex brick"):
+        mpi.render_object(comm, field, view, shape=9, balance="interleaved",
+                          compositing="radix-k")
+    with pytest.raises(ValueError, match=r"radix-k factors \(2, 3\) multiply to 6, not the 1 "):
+        mpi.render_object(comm, field, view, shape=9, compositing=mpi.RadixK([2, 3]))
+    with pytest.raises(ValueError, match="factors must be an integer >= 2"):
+        mpi.RadixK([1, 4])
     with pytest.raises(ValueError, match="shape is required"):
         mpi.render_object(comm, field, view)
     with pytest.raises(TypeError, match="source must be an analytic field"):

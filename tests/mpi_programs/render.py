@@ -2,12 +2,14 @@
 
 Run as ``mpiexec -n P python render.py CONFIG_JSON``. CONFIG holds ``field`` (a data_gen name),
 ``params``, ``n`` (samples per axis), ``size`` (image), ``views`` (orbit keyword dicts),
-``filters`` and ``cases`` (``[compositing, balance]`` pairs, or ``["image", null]``); the
-transfer function is ``Glow(glow)``, or with ``threshold`` a ramp that is transparent below it;
-``shade`` adds Phong shading and ``gradient_opacity`` (``[magnitudes, factors]``) a gradient
-ramp.
+``filters`` (every view with each, unless a view names its own ``filter``) and ``cases``
+(``[compositing, balance]`` pairs, or ``["image", null]``; ``radix-k:2x3`` is radix-k with
+factors 2, 3); the transfer function is ``Glow(glow)``, or with ``threshold`` a ramp that is
+transparent below it; ``shade`` adds Phong shading and ``gradient_opacity``
+(``[magnitudes, factors]``) a gradient ramp.
 Rank 0 prints one JSON line: per case, the largest difference from the serial render, the
-bytes each rank sent per phase, and the samples per rank.
+bytes each rank sent per phase, the rectangles it sent while compositing, and the samples per
+rank.
 """
 
 import json
@@ -19,6 +21,12 @@ from mpi4py import MPI
 import data_gen
 import vrlib
 from vrlib.parallel import mpi
+
+
+def compositor(spec):
+    """A compositor name, or ``radix-k:AxB...`` for radix-k with those factors."""
+    name, _, factors = spec.partition(":")
+    return mpi.RadixK([int(f) for f in factors.split("x")]) if factors else name
 
 
 def main(comm, config):
@@ -34,8 +42,10 @@ def main(comm, config):
                                         **extras)
     results = []
     for orbit in config["views"]:
+        orbit = dict(orbit)
+        filters = [orbit.pop("filter")] if "filter" in orbit else config["filters"]
         view = vrlib.View.orbit(size=config["size"], **orbit)
-        for filt in config["filters"]:
+        for filt in filters:
             serial = None
             if comm.Get_rank() == 0:
                 serial = vrlib.render(field.sample(config["n"]), view, filter=filt,
@@ -47,7 +57,8 @@ def main(comm, config):
                 else:
                     frame = mpi.render_object(comm, field, view, shape=config["n"],
                                               filter=filt, transfer=transfer,
-                                              compositing=compositing, balance=balance)
+                                              compositing=compositor(compositing),
+                                              balance=balance)
                 if comm.Get_rank() == 0:
                     results.append({
                         "view": orbit, "filter": filt, "compositing": compositing,
@@ -55,6 +66,7 @@ def main(comm, config):
                         "difference": float(np.abs(frame.image.rgba - serial).max()),
                         "alpha_max": float(serial[..., 3].max()),
                         "bytes": [r["bytes"] for r in frame.ranks],
+                        "messages": [r.get("messages", []) for r in frame.ranks],
                         "samples": [r["samples"] for r in frame.ranks],
                     })
     if comm.Get_rank() == 0:

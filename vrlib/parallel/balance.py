@@ -59,11 +59,12 @@ def visible_cells(data, first, lo, hi, shape, *, filter="trilinear", transfer=No
     return work
 
 
-def work_split(block_work, cells, parts):
+def work_split(block_work, cells, parts, *, groups=None):
     """The work-sized k-d split: ``parts`` bricks of ``cells`` (z, y, x), each side of every
     cut holding visible volume (``block_work``, per block) in proportion to its bricks. A
     small floor (1% of the densest block's per-cell weight) keeps empty regions from being
-    free, since rays still cross them.
+    free, since rays still cross them. ``groups`` as :func:`vrlib.parallel.decompose.split`
+    (radix-k's subtrees).
 
     Examples
     --------
@@ -75,7 +76,7 @@ def work_split(block_work, cells, parts):
     weights = per_cell.repeat(BLOCK, 0).repeat(BLOCK, 1).repeat(BLOCK, 2)
     weights = weights[: cells[0], : cells[1], : cells[2]]
     weights = weights + 0.01 * max(float(weights.max()), 1e-300)
-    return split(cells, parts, weights=weights)
+    return split(cells, parts, weights=weights, groups=groups)
 
 
 def visible_work(comm, lattice, read, tree, filt, transfer, sent):

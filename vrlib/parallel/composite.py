@@ -1,26 +1,39 @@
 """Sort-last compositing: how ranks' local images become one, in one registry.
 
-Each compositor is one entry of :data:`COMPOSITORS`, with the two faces the package needs:
+A compositor is a sequence of *rounds*; in each, a rank sends rectangles of pixels to some
+ranks and receives rectangles from others. Each entry of :data:`COMPOSITORS` has the faces the
+package needs, built on the same schedule (which rank sends which screen region to which, in
+which round):
 
-* ``composite(comm, held, tree, order, view, sent)``: the real thing, over MPI. ``held`` is
-  this rank's ``[(brick, rgba), ...]`` (full-screen local images), ``order`` the k-d tree's
-  bricks front to back; returns this rank's finished screen rectangle and its pixels, and
-  counts the bytes it sends in ``sent["composite"]``.
-* ``messages(tree, owners, tiles, view, origin, spacing, *, bytes_per_pixel, **options)``:
-  the same frame's messages (:class:`~vrlib.parallel.traffic.Messages`), sized from the
-  bricks' projected footprints, for the simulated network (:mod:`vrlib.parallel.network`).
+* ``composite(exchange, held, tree, owners, order, view)``: the real thing, over MPI
+  (:class:`~vrlib.parallel.exchange.Exchange`). ``held`` is this rank's
+  ``[(brick, rgba), ...]`` (full-screen local images), ``owners`` the rank of each brick,
+  ``order`` the k-d tree's bricks front to back; returns this rank's finished screen rectangle
+  and its pixels.
+* ``rounds(tree, owners, tiles, view, origin, spacing, *, bytes_per_pixel)``: the same frame's
+  messages round by round (:class:`~vrlib.parallel.traffic.Messages`), sized from the bricks'
+  projected footprints, for the simulated network (:mod:`vrlib.parallel.network`);
+  ``messages(...)`` sums them.
+* ``split(cells, ranks, weights=None)``: the k-d tree of one brick per rank whose subtrees
+  match the compositor's groups.
 
-Both count only what was drawn (the bounding rectangle of each local image's content), so the
-simulation and the MPI renderer agree up to headers (``tests/test_parallel_mpi.py``).
+Both faces send only what was drawn (the bounding rectangle of each image's content within the
+region sent), so the simulation bounds every message the MPI renderer sends
+(``tests/test_parallel_mpi.py`` checks them pair by pair).
 
 * **direct send**: each rank owns one screen tile and receives, from every rank, the part of
-  each local image that falls on it;
+  each local image that falls on it: one round of ``P - 1`` messages per rank;
 * **binary swap** (Ma et al. 1994): ``log2 P`` rounds in which pairs swap halves of their
   current screen region. Rank counts that are not powers of two fold pairs of k-d siblings
-  together first. It needs one convex brick per rank.
+  together first (those ranks then idle). It needs one convex brick per rank;
+* **radix-k** (Peterka et al. 2009): ``P = k_1 k_2 ... k_m``; in round ``i`` groups of
+  ``k_i`` ranks split their current region into ``k_i`` pieces and each gathers one piece from
+  the others. ``k = 2`` every round is binary swap, one round of ``k = P`` is direct send onto
+  strips, and any rank count works with every rank busy to the end (a prime count is one
+  round). The default factorisation takes factors of at most 8 (IceT's default ``k``).
 
-A new compositor is a class here with those two methods and an entry in :data:`COMPOSITORS`;
-the MPI renderer, its argument check and the chapters read the registry.
+A new compositor is a class here with those methods and an entry in :data:`COMPOSITORS`; the
+MPI renderer, its argument check, the network simulation and the chapters read the registry.
 """
 
 from __future__ import annotations
@@ -28,10 +41,11 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from mpi4py import MPI
 
+from vrlib import validate
 from vrlib.compositing import over
-from vrlib.parallel.decompose import screen_tiles
+from vrlib.parallel.decompose import screen_tiles, split
+from vrlib.parallel.exchange import HEADER
 from vrlib.parallel.rects import (
     NOTHING,
     area,
@@ -39,98 +53,103 @@ from vrlib.parallel.rects import (
     content,
     intersect,
     is_empty,
-    pixels,
     tile_overlaps,
     union,
 )
-from vrlib.parallel.traffic import Messages, footprint_rect
+from vrlib.parallel.traffic import Messages, footprint_rect, sum_messages
 
-__all__ = ["COMPOSITORS", "Compositor", "DirectSend", "BinarySwap", "HEADER",
-           "direct_send_messages", "binary_swap_messages", "swap_slots", "swap_halves",
-           "gather_to_root"]
-
-#: Header bytes counted for each rectangle sent (four int64 pixel bounds).
-HEADER = 32
+__all__ = ["COMPOSITORS", "Compositor", "DirectSend", "BinarySwap", "RadixK", "HEADER",
+           "direct_send_messages", "binary_swap_rounds", "binary_swap_messages",
+           "radix_k_rounds", "radix_k_messages", "swap_slots",
+           "swap_halves", "split_region", "radix_factors", "gather_to_root"]
 
 
 class Compositor:
-    """A sort-last compositing algorithm (see the module docstring for its two methods)."""
+    """A sort-last compositing algorithm (see the module docstring for its methods)."""
 
     name: str
     #: True when each rank must hold exactly one convex brick.
     one_brick_per_rank: bool = False
 
-    def composite(self, comm, held, tree, order, view, sent):
+    def split(self, cells, ranks, weights=None):
+        """The k-d tree of ``ranks`` bricks this compositor composites, brick ``i`` on rank
+        ``i``."""
+        return split(cells, ranks, weights=weights)
+
+    def composite(self, exchange, held, tree, owners, order, view):
+        raise NotImplementedError
+
+    def rounds(self, tree, owners, tiles, view, origin, spacing, *, bytes_per_pixel=4):
         raise NotImplementedError
 
     def messages(self, tree, owners, tiles, view, origin, spacing, *, bytes_per_pixel=4,
                  **options):
-        raise NotImplementedError
+        """All of a frame's messages (the rounds' summed)."""
+        return sum_messages(self.rounds(tree, owners, tiles, view, origin, spacing,
+                                        bytes_per_pixel=bytes_per_pixel, **options),
+                            _nodes(owners, tiles))
 
     def __repr__(self):
         return f"COMPOSITORS[{self.name!r}]"
+
+
+def _nodes(owners, tiles):
+    return max(int(np.max(owners)) + 1, 0 if tiles is None else tiles.nodes)
+
+
+def _composite_in_order(region, pieces):
+    """Pixels of ``region`` from ``pieces`` ``[(key, rect, rgba_of_rect), ...]`` composited
+    front to back by ``key`` (the visibility order)."""
+    out = np.zeros((region[1] - region[0], region[3] - region[2], 4))
+    for _key, rect, buf in sorted(pieces, key=lambda piece: piece[0]):
+        if buf is None:
+            continue
+        r0, r1 = rect[0] - region[0], rect[1] - region[0]
+        c0, c1 = rect[2] - region[2], rect[3] - region[2]
+        out[r0:r1, c0:c1] = over(out[r0:r1, c0:c1], buf)
+    return out
+
+
+def _own(rgba, rect):
+    """This rank's own pixels of ``rect``, as a piece (None when it drew nothing there)."""
+    drawn = content(rgba, rect)
+    if is_empty(drawn):
+        return NOTHING, None
+    return drawn, rgba[drawn[0]:drawn[1], drawn[2]:drawn[3]]
 
 
 # ---------------------------------------------------------------- direct send
 
 
 class DirectSend(Compositor):
-    """Direct send: every local image, cut by the screen tiles, goes to each tile's owner."""
+    """Direct send: every local image, cut by the screen tiles, goes to each tile's owner.
+    Takes any number of bricks per rank."""
 
     name = "direct-send"
 
-    def composite(self, comm, held, tree, order, view, sent):
+    def composite(self, exchange, held, tree, owners, order, view):
+        rank, size = exchange.rank, exchange.size
         position = {b: i for i, b in enumerate(order)}
-        tiles = screen_tiles(view.height, view.width, comm.Get_size())
-        return _direct_send(comm, [rgba for _, rgba in held],
-                            [position[brick.index] for brick, _ in held], tiles, sent)
+        tiles = screen_tiles(view.height, view.width, size)
+        mine = tiles.rects(rank)[0]
+        sends, pieces = [], []
+        for brick, rgba in sorted(held, key=lambda item: item[0].index):
+            drawn = content(rgba)
+            for dest in range(size):
+                if dest != rank:
+                    sends.append((dest, clip(drawn, tiles.rects(dest)[0]), rgba))
+            pieces.append((position[brick.index], *_own(rgba, mine)))
+        # Each source sends its bricks in index order.
+        sources = [(int(owners[b]), b) for b in range(len(tree)) if owners[b] != rank]
+        sources.sort()
+        received = exchange.swap(0, sends, [s for s, _ in sources])
+        pieces += [(position[b], rect, buf) for (_, b), (rect, buf) in zip(sources, received,
+                                                                             strict=True)]
+        return mine, _composite_in_order(mine, pieces)
 
-    def messages(self, tree, owners, tiles, view, origin, spacing, *, bytes_per_pixel=4):
-        return direct_send_messages(tree, owners, tiles, view, origin, spacing,
-                                    bytes_per_pixel=bytes_per_pixel)[0]
-
-
-def _direct_send(comm, images, keys, tiles, sent):
-    """Send each local image's part on every tile to the tile's owner; composite the parts
-    received in ``keys`` order (front to back). Returns this rank's tile rectangle and
-    pixels."""
-    size, rank = comm.Get_size(), comm.Get_rank()
-    mine = tiles.rects(rank)[0]
-    headers = [[] for _ in range(size)]
-    payloads = [[] for _ in range(size)]
-    for rgba, key in zip(images, keys, strict=True):
-        drawn = content(rgba)
-        for dest in range(size):
-            part = clip(drawn, tiles.rects(dest)[0])
-            if not is_empty(part):
-                headers[dest].append((key, part))
-                payloads[dest].append(pixels(rgba, part))
-    incoming = comm.alltoall(headers)
-    sent["composite"] += HEADER * sum(len(h) for d, h in enumerate(headers) if d != rank)
-    requests, received = [], []
-    for dest in range(size):
-        if dest == rank:
-            continue
-        for buf in payloads[dest]:
-            requests.append(comm.Isend(buf, dest=dest, tag=7))
-            sent["composite"] += buf.nbytes
-    for source in range(size):
-        if source == rank:
-            received += [(key, part, buf) for (key, part), buf in zip(headers[rank],
-                                                                        payloads[rank],
-                                                                        strict=True)]
-            continue
-        for key, part in incoming[source]:
-            buf = np.empty((part[1] - part[0], part[3] - part[2], 4))
-            comm.Recv(buf, source=source, tag=7)
-            received.append((key, part, buf))
-    MPI.Request.Waitall(requests)
-    tile = np.zeros((mine[1] - mine[0], mine[3] - mine[2], 4))
-    for _key, part, buf in sorted(received, key=lambda item: item[0]):
-        r0, r1 = part[0] - mine[0], part[1] - mine[0]
-        c0, c1 = part[2] - mine[2], part[3] - mine[2]
-        tile[r0:r1, c0:c1] = over(tile[r0:r1, c0:c1], buf)
-    return mine, tile
+    def rounds(self, tree, owners, tiles, view, origin, spacing, *, bytes_per_pixel=4):
+        return [direct_send_messages(tree, owners, tiles, view, origin, spacing,
+                                     bytes_per_pixel=bytes_per_pixel)[0]]
 
 
 def direct_send_messages(tree, owners, tiles, view, origin, spacing, *, bytes_per_pixel=4):
@@ -177,72 +196,55 @@ class BinarySwap(Compositor):
     name = "binary-swap"
     one_brick_per_rank = True
 
-    def composite(self, comm, held, tree, order, view, sent):
-        rect, full = _binary_swap(comm, tree, held[0][1], order, sent)
-        return rect, (pixels(full, rect) if not is_empty(rect) else None)
+    def composite(self, exchange, held, tree, owners, order, view):
+        rank = exchange.rank
+        rgba = held[0][1]
+        height, width = rgba.shape[:2]
+        position = {brick: i for i, brick in enumerate(order)}
+        slots = swap_slots(tree)
+        leaders = []
+        for slot in slots:
+            if not isinstance(slot, tuple):
+                leaders.append(slot)
+                continue
+            first, second = slot[2], slot[3]
+            if rank == second:  # fold: hand everything to the sibling and stop
+                exchange.swap(0, [(first, content(rgba), rgba)], [])
+                return NOTHING, None
+            if rank == first:
+                ((rect, buf),) = exchange.swap(0, [], [second])
+                _merge(rgba, rect, buf, position[first] < position[second])
+            leaders.append(first)
+        s = leaders.index(rank)
+        region = (0, height, 0, width)
+        for r in range(int(math.log2(len(slots)))):
+            partner_slot = s ^ (1 << r)
+            partner = leaders[partner_slot]
+            keep, give = swap_halves(region, s < partner_slot)
+            ((rect, buf),) = exchange.swap(1 + r, [(partner, content(rgba, give), rgba)],
+                                           [partner])
+            # The group whose bricks come first in the visibility order is in front.
+            group = 1 << (r + 1)
+            mine_front = min(position[b] for b in _group(tree, slots, s, group)) < \
+                min(position[b] for b in _group(tree, slots, partner_slot, group))
+            _merge(rgba, rect, buf, mine_front)
+            region = keep
+        return region, np.ascontiguousarray(rgba[region[0]:region[1], region[2]:region[3]])
 
-    def messages(self, tree, owners, tiles, view, origin, spacing, *, bytes_per_pixel=4,
-                 bounded=True):
+    def rounds(self, tree, owners, tiles, view, origin, spacing, *, bytes_per_pixel=4,
+               bounded=True):
         if not np.array_equal(owners, np.arange(len(tree))):
             raise ValueError("binary swap takes brick i on node i (owners 0, 1, ...)")
-        return binary_swap_messages(tree, view, origin, spacing,
-                                    bytes_per_pixel=bytes_per_pixel, bounded=bounded)
-
-
-def _exchange(comm, partner, rgba, rect_out, sent):
-    """Send the pixels ``rect_out`` of ``rgba`` to ``partner`` and receive the pixels it
-    sends (the rectangle it names first); returns (rect, pixels) received."""
-    theirs = comm.sendrecv(rect_out, dest=partner, source=partner)
-    sent["composite"] += HEADER
-    buf = np.empty((max(theirs[1] - theirs[0], 0), max(theirs[3] - theirs[2], 0), 4))
-    out = pixels(rgba, rect_out) if not is_empty(rect_out) else np.empty((0, 0, 4))
-    comm.Sendrecv(out, dest=partner, recvbuf=buf, source=partner)
-    sent["composite"] += out.nbytes
-    return theirs, buf
+        return binary_swap_rounds(tree, view, origin, spacing,
+                                  bytes_per_pixel=bytes_per_pixel, bounded=bounded)
 
 
 def _merge(rgba, rect, buf, mine_in_front):
     """Composite received pixels into ``rgba`` at ``rect``."""
-    if is_empty(rect):
+    if buf is None:
         return
     region = rgba[rect[0]:rect[1], rect[2]:rect[3]]
     region[...] = over(region, buf) if mine_in_front else over(buf, region)
-
-
-def _binary_swap(comm, tree, rgba, order, sent):
-    """Binary swap over the tree's slots (brick ``i`` on rank ``i``). Returns this rank's
-    final screen rectangle (empty on ranks folded away) and the full-size image holding it."""
-    rank = comm.Get_rank()
-    height, width = rgba.shape[:2]
-    position = {brick: i for i, brick in enumerate(order)}
-    slots = swap_slots(tree)
-    leaders = []
-    for slot in slots:
-        if isinstance(slot, tuple):
-            first, second = slot[2], slot[3]
-            if rank == second:  # fold: hand everything to the sibling and stop
-                _exchange(comm, first, rgba, content(rgba), sent)
-                return NOTHING, rgba
-            if rank == first:
-                theirs, buf = _exchange(comm, second, rgba, NOTHING, sent)
-                _merge(rgba, theirs, buf, position[first] < position[second])
-            leaders.append(first)
-        else:
-            leaders.append(slot)
-    s = leaders.index(rank)
-    region = (0, height, 0, width)
-    for r in range(int(math.log2(len(slots)))):
-        partner_slot = s ^ (1 << r)
-        partner = leaders[partner_slot]
-        keep, give = swap_halves(region, s < partner_slot)
-        theirs, buf = _exchange(comm, partner, rgba, content(rgba, give), sent)
-        # The group whose bricks come first in the visibility order is in front.
-        group = 1 << (r + 1)
-        mine_front = min(position[b] for b in _group(tree, slots, s, group)) < \
-            min(position[b] for b in _group(tree, slots, partner_slot, group))
-        _merge(rgba, theirs, buf, mine_front)
-        region = keep
-    return region, rgba
 
 
 def _group(tree, slots, slot, size):
@@ -301,8 +303,9 @@ def swap_halves(region, lower):
     return halves if lower else halves[::-1]
 
 
-def binary_swap_messages(tree, view, origin, spacing, *, bytes_per_pixel=4, bounded=True):
-    """Binary swap (Ma et al. 1994) on the k-d tree's bricks, brick ``i`` on node ``i``.
+def binary_swap_rounds(tree, view, origin, spacing, *, bytes_per_pixel=4, bounded=True):
+    """Binary swap (Ma et al. 1994) on the k-d tree's bricks, brick ``i`` on node ``i``: the
+    messages of each round, the fold first (empty when ``P`` is a power of two).
 
     Pairs folded into one slot first send the second brick's image to the first; then in
     round ``r`` slot ``s`` swaps halves of its current screen region with slot ``s ^ 2^r``.
@@ -315,10 +318,10 @@ def binary_swap_messages(tree, view, origin, spacing, *, bytes_per_pixel=4, boun
     >>> from vrlib import View
     >>> from vrlib.parallel.decompose import split
     >>> view = View.orbit(size=16)
-    >>> m = binary_swap_messages(split((8, 8, 8), 4), view, (-1, -1, -1), (0.25, 0.25, 0.25),
-    ...                 bytes_per_pixel=1, bounded=False)
-    >>> m.sent_per_node(4).tolist()               # 16^2 x (1 - 1/4) each
-    [192.0, 192.0, 192.0, 192.0]
+    >>> rounds = binary_swap_rounds(split((8, 8, 8), 4), view, (-1, -1, -1),
+    ...                             (0.25, 0.25, 0.25), bytes_per_pixel=1, bounded=False)
+    >>> [m.sent_per_node(4).tolist() for m in rounds]     # no fold; 128 then 64 pixels each
+    [[0.0, 0.0, 0.0, 0.0], [128.0, 128.0, 128.0, 128.0], [64.0, 64.0, 64.0, 64.0]]
     """
     slots = swap_slots(tree)
     full = (0, view.height, 0, view.width)
@@ -337,8 +340,10 @@ def binary_swap_messages(tree, view, origin, spacing, *, bytes_per_pixel=4, boun
         else:
             leader.append(slot)
             held.append(rects[slot])
+    out = [Messages.merged(src, dst, size, nodes)]
     region = [full] * len(slots)
     for r in range(int(math.log2(len(slots)))):
+        src, dst, size = [], [], []
         new_held = list(held)
         for s in range(len(slots)):
             partner = s ^ (1 << r)
@@ -350,11 +355,240 @@ def binary_swap_messages(tree, view, origin, spacing, *, bytes_per_pixel=4, boun
             region[s] = keep
             new_held[s] = union(held[s], held[partner])
         held = new_held
-    return Messages.merged(src, dst, size, nodes)
+        out.append(Messages.merged(src, dst, size, nodes))
+    return out
+
+
+def binary_swap_messages(tree, view, origin, spacing, *, bytes_per_pixel=4, bounded=True):
+    """All of binary swap's messages (:func:`binary_swap_rounds` summed).
+
+    Examples
+    --------
+    >>> from vrlib import View
+    >>> from vrlib.parallel.decompose import split
+    >>> view = View.orbit(size=16)
+    >>> m = binary_swap_messages(split((8, 8, 8), 4), view, (-1, -1, -1), (0.25, 0.25, 0.25),
+    ...                 bytes_per_pixel=1, bounded=False)
+    >>> m.sent_per_node(4).tolist()               # 16^2 x (1 - 1/4) each
+    [192.0, 192.0, 192.0, 192.0]
+    """
+    return sum_messages(binary_swap_rounds(tree, view, origin, spacing,
+                                           bytes_per_pixel=bytes_per_pixel, bounded=bounded),
+                        len(tree))
+
+
+# ---------------------------------------------------------------- radix-k
+
+
+def radix_factors(ranks, target=8):
+    """Radix-k's default factorisation of ``ranks``: its prime factors, smallest first, each
+    multiplied into the previous factor while that stays at most ``target``.
+
+    Examples
+    --------
+    >>> radix_factors(12), radix_factors(64), radix_factors(7), radix_factors(8, target=2)
+    ([4, 3], [8, 8], [7], [2, 2, 2])
+    >>> radix_factors(4096), radix_factors(1)
+    ([8, 8, 8, 8], [])
+    """
+    n = validate.positive_int("ranks", ranks)
+    target = validate.positive_int("target", target, minimum=2)
+    primes, f = [], 2
+    while f * f <= n:
+        while n % f == 0:
+            primes.append(f)
+            n //= f
+        f += 1
+    if n > 1:
+        primes.append(n)
+    factors = []
+    for p in primes:
+        if factors and factors[-1] * p <= target:
+            factors[-1] *= p
+        else:
+            factors.append(p)
+    return factors
+
+
+def split_region(region, k):
+    """A screen ``region`` ``(r0, r1, c0, c1)`` cut into ``k`` strips across its longer side
+    (piece ``j`` from ``j * length // k``); some are empty when the side is shorter than ``k``.
+
+    Examples
+    --------
+    >>> split_region((0, 6, 0, 4), 3)
+    [(0, 2, 0, 4), (2, 4, 0, 4), (4, 6, 0, 4)]
+    >>> split_region((0, 2, 0, 7), 2)
+    [(0, 2, 0, 3), (0, 2, 3, 7)]
+    """
+    r0, r1, c0, c1 = region
+    rows = r1 - r0 >= c1 - c0
+    start, length = (r0, r1 - r0) if rows else (c0, c1 - c0)
+    cuts = [start + j * length // k for j in range(k + 1)]
+    if rows:
+        return [(cuts[j], cuts[j + 1], c0, c1) for j in range(k)]
+    return [(r0, r1, cuts[j], cuts[j + 1]) for j in range(k)]
+
+
+def _members(rank, stride, k):
+    """Radix-k: this rank's digit and its group of ``k`` ranks in the round of ``stride``."""
+    digit = (rank // stride) % k
+    return digit, [rank + (j - digit) * stride for j in range(k)]
+
+
+class RadixK(Compositor):
+    """Radix-k over the k-d tree's bricks, brick ``i`` on rank ``i``.
+
+    Parameters
+    ----------
+    factors : sequence of int, optional
+        ``k`` of each round, first round first; their product must be the rank count.
+        Default: :func:`radix_factors` with ``target``.
+    target : int
+        Largest factor the default factorisation makes (IceT's default is 8).
+
+    Examples
+    --------
+    >>> RadixK().factors_for(24), RadixK([2, 3, 4]).factors_for(24)
+    ([8, 3], [2, 3, 4])
+    >>> RadixK([2, 3]).factors_for(8)
+    Traceback (most recent call last):
+    ...
+    ValueError: radix-k factors (2, 3) multiply to 6, not the 8 ranks
+    """
+
+    name = "radix-k"
+    one_brick_per_rank = True
+
+    def __init__(self, factors=None, *, target=8):
+        self.target = validate.positive_int("target", target, minimum=2)
+        self.factors = None if factors is None else tuple(
+            validate.positive_int("factors", f, minimum=2) for f in factors)
+
+    def factors_for(self, ranks):
+        """The factorisation used for ``ranks`` ranks."""
+        if self.factors is None:
+            return radix_factors(ranks, self.target)
+        if math.prod(self.factors) != ranks:
+            raise ValueError(f"radix-k factors {self.factors} multiply to "
+                             f"{math.prod(self.factors)}, not the {ranks} ranks")
+        return list(self.factors)
+
+    def split(self, cells, ranks, weights=None):
+        return split(cells, ranks, weights=weights, groups=self.factors_for(ranks))
+
+    def composite(self, exchange, held, tree, owners, order, view):
+        rank = exchange.rank
+        rgba = held[0][1]
+        position = {b: i for i, b in enumerate(order)}
+        region, stride = (0, rgba.shape[0], 0, rgba.shape[1]), 1
+
+        def key(member):
+            # A member's image holds the block of ``stride`` bricks its group has merged, a
+            # subtree of the k-d tree, so contiguous in the visibility order.
+            first = member // stride * stride
+            return min(position[b] for b in range(first, first + stride))
+
+        for round, k in enumerate(self.factors_for(exchange.size)):
+            digit, members = _members(rank, stride, k)
+            pieces = split_region(region, k)
+            others = [m for j, m in enumerate(members) if j != digit]
+            received = exchange.swap(
+                round, [(m, content(rgba, pieces[j]), rgba) for j, m in enumerate(members)
+                        if j != digit], others)
+            region = pieces[digit]
+            parts = [(key(rank), *_own(rgba, region))]
+            parts += [(key(m), rect, buf) for m, (rect, buf) in zip(others, received,
+                                                                     strict=True)]
+            rgba[region[0]:region[1], region[2]:region[3]] = _composite_in_order(region,
+                                                                                 parts)
+            stride *= k
+        return region, np.ascontiguousarray(rgba[region[0]:region[1], region[2]:region[3]])
+
+    def rounds(self, tree, owners, tiles, view, origin, spacing, *, bytes_per_pixel=4):
+        if not np.array_equal(owners, np.arange(len(tree))):
+            raise ValueError("radix-k takes brick i on node i (owners 0, 1, ...)")
+        return radix_k_rounds(tree, view, origin, spacing, self.factors_for(len(tree)),
+                              bytes_per_pixel=bytes_per_pixel)
+
+    def __repr__(self):
+        if self.factors is None and self.target == 8:
+            return "COMPOSITORS['radix-k']"
+        return f"RadixK({list(self.factors) if self.factors else None}, target={self.target})"
+
+
+def radix_k_rounds(tree, view, origin, spacing, factors, *, bytes_per_pixel=4):
+    """Radix-k (Peterka et al. 2009) on the k-d tree's bricks, brick ``i`` on node ``i``: the
+    messages of each round. Node ``s`` sends each member of its group the part of that
+    member's piece inside the bounding rectangle of what its own group has merged so far
+    (vectorised over the nodes, so thousands of nodes and large ``k`` route in a moment).
+
+    Examples
+    --------
+    >>> from vrlib import View
+    >>> from vrlib.parallel.decompose import split
+    >>> view = View.orbit(size=12)
+    >>> rounds = radix_k_rounds(split((6, 6, 6), 6, groups=[2, 3]), view, (-1, -1, -1),
+    ...                         (1 / 3, 1 / 3, 1 / 3), [2, 3], bytes_per_pixel=1)
+    >>> rounds[0].src.tolist(), rounds[0].dst.tolist()  # pairs (node 1 sends nothing)
+    ([0, 2, 3, 4, 5], [1, 3, 2, 5, 4])
+    >>> sorted(rounds[1].dst[rounds[1].src == 1].tolist())   # then triples {1, 3, 5}
+    [3, 5]
+    """
+    nodes = len(tree)
+    if math.prod(factors) != nodes:
+        raise ValueError(f"radix-k factors {tuple(factors)} multiply to {math.prod(factors)}, "
+                         f"not the {nodes} nodes")
+    empty = np.array([np.inf, -np.inf, np.inf, -np.inf])
+    held = np.array([empty if is_empty(r) else r for r in
+                     (footprint_rect(view, *b.world_box(origin, spacing)) for b in tree.bricks)],
+                    dtype=float).reshape(nodes, 4)
+    region = np.tile(np.array([0, view.height, 0, view.width], dtype=np.int64), (nodes, 1))
+    node = np.arange(nodes)
+    out, stride = [], 1
+    for k in factors:
+        digit = (node // stride) % k
+        r0, r1, c0, c1 = region.T
+        rows = r1 - r0 >= c1 - c0
+        start = np.where(rows, r0, c0)
+        length = np.where(rows, r1 - r0, c1 - c0)
+        src, dst, size = [], [], []
+        merged = np.tile(empty, (nodes, 1))
+        kept = region.copy()
+        for j in range(k):
+            a, b = start + j * length // k, start + (j + 1) * length // k
+            piece = np.where(rows[:, None], np.stack([a, b, c0, c1], 1),
+                             np.stack([r0, r1, a, b], 1))
+            member = node + (j - digit) * stride
+            # What s sends member j: piece j inside what s holds.
+            h = np.clip(np.minimum(piece[:, 1], held[:, 1]) - np.maximum(piece[:, 0],
+                                                                         held[:, 0]), 0, None)
+            w = np.clip(np.minimum(piece[:, 3], held[:, 3]) - np.maximum(piece[:, 2],
+                                                                         held[:, 2]), 0, None)
+            send = j != digit
+            src.append(node[send])
+            dst.append(member[send])
+            size.append((h * w)[send] * bytes_per_pixel)
+            kept[digit == j] = piece[digit == j]
+            other = held[member]
+            merged = np.stack([np.minimum(merged[:, 0], other[:, 0]),
+                               np.maximum(merged[:, 1], other[:, 1]),
+                               np.minimum(merged[:, 2], other[:, 2]),
+                               np.maximum(merged[:, 3], other[:, 3])], 1)
+        out.append(Messages.merged(np.concatenate(src), np.concatenate(dst),
+                                   np.concatenate(size), nodes))
+        held, region, stride = merged, kept, stride * k
+    return out
+
+
+def radix_k_messages(tree, view, origin, spacing, factors, *, bytes_per_pixel=4):
+    """All of radix-k's messages (:func:`radix_k_rounds` summed)."""
+    return sum_messages(radix_k_rounds(tree, view, origin, spacing, factors,
+                                       bytes_per_pixel=bytes_per_pixel), len(tree))
 
 
 #: Compositors by name.
-COMPOSITORS = {c.name: c for c in (DirectSend(), BinarySwap())}
+COMPOSITORS = {c.name: c for c in (DirectSend(), BinarySwap(), RadixK())}
 
 
 # ---------------------------------------------------------------- the finished image

@@ -153,7 +153,7 @@ def _factorisations(n, k):
                 yield (first, *rest)
 
 
-def split(cells, parts, *, shape="blocks", weights=None, grid=None):
+def split(cells, parts, *, shape="blocks", weights=None, grid=None, groups=None):
     """Split a box of ``cells`` (z, y, x) into ``parts`` bricks by a k-d tree.
 
     Parameters
@@ -170,6 +170,10 @@ def split(cells, parts, *, shape="blocks", weights=None, grid=None):
         default: split the cells themselves evenly.
     grid : (int, int, int), optional
         Cut a regular grid with this many bricks per axis instead (product ``parts``).
+    groups : sequence of int, optional
+        Factors ``k_1, k_2, ...`` of ``parts`` (radix-k's rounds): the tree is cut so that
+        every block of ``k_1``, ``k_1 k_2``, ... consecutive bricks is a subtree, hence
+        contiguous in every visibility order.
 
     Raises
     ------
@@ -180,7 +184,8 @@ def split(cells, parts, *, shape="blocks", weights=None, grid=None):
     -----
     The tree halves the count at every level (``n`` into ``n // 2`` and ``n - n // 2``),
     cutting the longest allowed axis, so that its first ``floor(log2 parts)`` levels form a
-    perfect binary tree: what binary-swap compositing needs.
+    perfect binary tree: what binary-swap compositing needs. With ``groups`` a node of ``c``
+    blocks halves the blocks instead (``c // 2`` of them on the left).
 
     Examples
     --------
@@ -189,6 +194,9 @@ def split(cells, parts, *, shape="blocks", weights=None, grid=None):
     [((0, 0, 0), (4, 4, 8)), ((0, 4, 0), (4, 8, 8))]
     >>> tree.node[:2]                  # the first cut: z at cell 4
     (0, 4)
+    >>> six = split((8, 8, 8), 6, groups=[2, 3])     # pairs {0, 1}, {2, 3}, {4, 5}
+    >>> six.leaves(six.node[2]), six.leaves(six.node[3][2]), six.leaves(six.node[3][3])
+    ([0, 1], [2, 3], [4, 5])
     """
     cells = tuple(validate.positive_int("cells", c) for c in cells)
     parts = validate.positive_int("parts", parts)
@@ -211,7 +219,21 @@ def split(cells, parts, *, shape="blocks", weights=None, grid=None):
             f"cannot split {cells} cells into {parts} {shape} (at most {capacity}): use "
             "fewer parts or a larger volume"
         )
+    blocks = None
+    if groups is not None:
+        groups = [validate.positive_int("groups", g) for g in groups]
+        if math.prod(groups) != parts:
+            raise ValueError(f"groups {tuple(groups)} multiply to {math.prod(groups)}, not "
+                             f"the {parts} parts")
+        blocks = [math.prod(groups[:i]) for i in range(len(groups))]
     bricks = []
+
+    def left_count(n):
+        if blocks is None:
+            return n // 2
+        # The largest block size under n that n is made of: halve the blocks.
+        block = max(b for b in blocks if b < n and n % b == 0)
+        return n // block // 2 * block
 
     def build(lo, hi, n, counts):
         if n == 1:
@@ -227,7 +249,7 @@ def split(cells, parts, *, shape="blocks", weights=None, grid=None):
         else:
             open_axes = [a for a in axes if hi[a] - lo[a] > 1]
             axis = max(open_axes, key=lambda a: (hi[a] - lo[a], -a))
-            left_n = n // 2
+            left_n = left_count(n)
             position = _cut(lo, hi, axis, left_n / n, weights)
             sub_left = sub_right = None
         left_hi, right_lo = list(hi), list(lo)

@@ -33,15 +33,16 @@ from vrlib.arguments import render_arguments
 from vrlib.image import Image, RenderStats
 from vrlib.parallel import rects
 from vrlib.parallel.balance import BALANCE, visible_cells, visible_work, work_split
-from vrlib.parallel.composite import COMPOSITORS, HEADER, gather_to_root
+from vrlib.parallel.composite import COMPOSITORS, HEADER, Compositor, RadixK, gather_to_root
 from vrlib.parallel.decompose import interleaved_owners, screen_tiles, split
+from vrlib.parallel.exchange import Exchange
 from vrlib.parallel.sources import ghost, global_value_range, open_source
 from vrlib.parallel.stage import RankFailed, Stage
 from vrlib.raycast import cast_rays
 from vrlib.skipping import BLOCK, brick_empty_blocks, coarsen, footprint_mask
 
 __all__ = ["render_object", "render_image", "RankFailed", "Frame", "visible_cells",
-           "work_split", "COMPOSITORS", "BALANCE", "HEADER"]
+           "work_split", "COMPOSITORS", "RadixK", "BALANCE", "HEADER"]
 
 
 @dataclass
@@ -50,8 +51,9 @@ class Frame:
 
     ``image`` is the composited :class:`vrlib.Image` on the root rank (None elsewhere);
     ``ranks`` (root only) one dict per rank: bricks, samples, seconds rendering and
-    compositing, and bytes sent per phase (``balance``, ``voxels``, ``composite``,
-    ``gather``).
+    compositing, bytes sent per phase (``balance``, ``voxels``, ``composite``,
+    ``gather``), and (object partition) ``messages``, one ``[round, destination, pixels]``
+    per rectangle the rank sent while compositing.
 
     Examples
     --------
@@ -107,15 +109,16 @@ def _check(view, filter, transfer, step, compositing=None, balance=None,
                          "prefilter is a recursion along whole lines of the volume, while each "
                          "rank reads only its brick; use a filter applied to the samples "
                          "(e.g. 'catmull-rom'), or vrlib.render on one machine")
-    if compositing is not None:
-        validate.choice("compositing", compositing, tuple(COMPOSITORS))
+    if compositing is not None and not isinstance(compositing, Compositor):
+        compositing = COMPOSITORS[validate.choice("compositing", compositing,
+                                                  tuple(COMPOSITORS))]
     if balance is not None:
         validate.choice("balance", balance, BALANCE)
         validate.positive_int("bricks_per_rank", bricks_per_rank)
-        if balance == "interleaved" and COMPOSITORS[compositing].one_brick_per_rank:
-            raise ValueError(f"{compositing} compositing needs one convex brick per rank: use "
-                             "balance='even' or 'work', or compositing='direct-send'")
-    return filt, transfer, step
+        if balance == "interleaved" and compositing.one_brick_per_rank:
+            raise ValueError(f"{compositing.name} compositing needs one convex brick per rank: "
+                             "use balance='even' or 'work', or compositing='direct-send'")
+    return filt, transfer, step, compositing
 
 
 def render_object(comm, source, view, *, shape=None, extent=None, filter="trilinear",
@@ -137,9 +140,10 @@ def render_object(comm, source, view, *, shape=None, extent=None, filter="trilin
         As :func:`vrlib.render` (ray casting; shading and gradient opacity included). Early ray
         termination is off, so the image equals the serial render's with
         ``early_termination=1``.
-    compositing : str, default "binary-swap"
+    compositing : str or Compositor, default "binary-swap"
         A name from :data:`vrlib.parallel.composite.COMPOSITORS` ("binary-swap",
-        "direct-send").
+        "direct-send", "radix-k"), or a compositor such as ``RadixK([2, 3])`` (radix-k with
+        the factors of the rank count given round by round).
     balance : {"even", "interleaved", "work"}
         How bricks are cut and dealt (see the module's notes).
     bricks_per_rank : int
@@ -175,14 +179,16 @@ def render_object(comm, source, view, *, shape=None, extent=None, filter="trilin
     size, rank = comm.Get_size(), comm.Get_rank()
     sent = {"balance": 0, "voxels": 0, "composite": 0, "gather": 0}
     with Stage(comm, "checking the arguments"):
-        filt, transfer, step = _check(view, filter, transfer, step, compositing,
-                                      balance, bricks_per_rank)
+        filt, transfer, step, compositor = _check(view, filter, transfer, step, compositing,
+                                                  balance, bricks_per_rank)
         root = _root(root, size)
         lattice, read = open_source(source, shape, extent)
-        parts = size * bricks_per_rank if balance == "interleaved" else size
-        tree = split(lattice.cells, parts)
-        owners = interleaved_owners(parts, size) if balance == "interleaved" else \
-            np.arange(size)
+        if balance == "interleaved":
+            tree = split(lattice.cells, size * bricks_per_rank)
+        else:
+            tree = compositor.split(lattice.cells, size)
+        groups = compositor.factors_for(size) if isinstance(compositor, RadixK) else None
+        owners = interleaved_owners(len(tree), size)
     ds = step * float(lattice.spacing.min())
     with Stage(comm, "reading its bricks"):
         mine = [b for b in tree.bricks if owners[b.index] == rank]
@@ -195,7 +201,7 @@ def render_object(comm, source, view, *, shape=None, extent=None, filter="trilin
     if balance == "work":
         with Stage(comm, "measuring its visible volume"):
             block_work = visible_work(comm, lattice, read, tree, filt, transfer, sent)
-        tree = work_split(block_work, lattice.cells, size)
+        tree = work_split(block_work, lattice.cells, size, groups=groups)
         with Stage(comm, "reading its re-balanced brick"):
             brick = tree.bricks[rank]
             region = brick.samples(ghost(filt), lattice.shape)
@@ -211,11 +217,14 @@ def render_object(comm, source, view, *, shape=None, extent=None, filter="trilin
         render_s = time.perf_counter() - start
     start = time.perf_counter()
     order = tree.order(view, lattice.origin, lattice.spacing)
-    rect, finished = COMPOSITORS[compositing].composite(comm, held, tree, order, view, sent)
+    log = []  # [round, destination, pixels] per rectangle sent
+    with Exchange(comm, compositor.name, sent, log) as exchange:
+        rect, finished = compositor.composite(exchange, held, tree, owners, order, view)
     composite_s = time.perf_counter() - start
     rgba = gather_to_root(comm, rect, finished, view.shape, root, sent)
     stats = {"rank": rank, "bricks": len(bricks), "samples": int(samples),
-             "render_s": render_s, "composite_s": composite_s, "bytes": sent}
+             "render_s": render_s, "composite_s": composite_s, "bytes": sent,
+             "messages": log}
     ranks = comm.gather(stats, root=root)
     if rank != root:
         return Frame(None)
@@ -277,7 +286,7 @@ def render_image(comm, source, view, *, shape=None, extent=None, filter="triline
     size, rank = comm.Get_size(), comm.Get_rank()
     sent = {"balance": 0, "voxels": 0, "composite": 0, "gather": 0}
     with Stage(comm, "checking the arguments"):
-        filt, transfer, step = _check(view, filter, transfer, step)
+        filt, transfer, step, _ = _check(view, filter, transfer, step)
         root = _root(root, size)
         lattice, read = open_source(source, shape, extent)
         tree = split(lattice.cells, size)

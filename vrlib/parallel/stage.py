@@ -1,7 +1,9 @@
 """Failure in a distributed frame: a rank that raises ends the frame on every rank.
 
-A frame runs as a sequence of stages (checking the arguments, reading bricks, rendering, ...);
-at the end of each, the ranks learn whether any of them raised. The rank that raised re-raises
+A frame runs as a sequence of stages (checking the arguments, reading bricks, rendering,
+compositing, ...); at the end of each, the ranks learn whether any of them raised. (Inside a
+stage whose ranks wait on each other, compositing, a failure notice also ends the waits:
+:mod:`vrlib.parallel.exchange`.) The rank that raised re-raises
 its own error and the others raise :class:`RankFailed` naming it, so ``mpiexec`` returns within
 seconds instead of hanging in the next collective call.
 """
@@ -25,6 +27,7 @@ class RankFailed(RuntimeError):
         super().__init__(f"rank {rank} failed while {stage}: {message}")
         self.rank = rank
         self.stage = stage
+        self.message = message
 
 
 class Stage:
@@ -49,9 +52,12 @@ class Stage:
     def __exit__(self, kind, value, traceback):
         if kind is not None and not issubclass(kind, Exception):
             return False
-        report = None if value is None else (self.comm.Get_rank(),
-                                             f"{kind.__name__}: {value}")
+        report = None
+        if isinstance(value, RankFailed):  # learnt from another rank: pass its report on
+            report = (value.rank, value.stage, value.message)
+        elif value is not None:
+            report = (self.comm.Get_rank(), self.name, f"{kind.__name__}: {value}")
         failed = [r for r in self.comm.allgather(report) if r is not None]
         if not failed or value is not None:
             return False
-        raise RankFailed(failed[0][0], self.name, failed[0][1])
+        raise RankFailed(*min(failed))

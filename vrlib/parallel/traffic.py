@@ -18,7 +18,8 @@ import numpy as np
 
 from vrlib.parallel.rects import area
 
-__all__ = ["Messages", "footprint_rect", "gather", "image_static", "image_dynamic"]
+__all__ = ["Messages", "sum_messages", "footprint_rect", "gather", "image_static",
+           "image_dynamic"]
 
 #: Most voxels projected when counting an image partition's traffic; larger volumes are
 #: counted on a sub-lattice whose every voxel stands for ``stride^3`` of them.
@@ -63,7 +64,24 @@ class Messages:
 
     def sent_per_node(self, nodes):
         """Bytes each node sends."""
-        return np.bincount(self.src, self.bytes, minlength=nodes)
+        return np.bincount(self.src, self.bytes, minlength=nodes).astype(np.float64)
+
+
+def sum_messages(rounds, nodes):
+    """Several rounds' messages as one frame's (repeated pairs merged).
+
+    Examples
+    --------
+    >>> a = Messages.merged([0], [1], [3.0], nodes=2)
+    >>> sum_messages([a, a], 2).bytes.tolist()
+    [6.0]
+    """
+    rounds = list(rounds)
+    if not rounds:
+        return Messages.merged([], [], [], nodes)
+    return Messages.merged(np.concatenate([m.src for m in rounds]),
+                           np.concatenate([m.dst for m in rounds]),
+                           np.concatenate([m.bytes for m in rounds]), nodes)
 
 
 def footprint_rect(view, lo, hi):
