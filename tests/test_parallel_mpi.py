@@ -145,6 +145,21 @@ def test_every_message_is_bounded_by_the_simulated_one():
         assert sent >= 0.5 * sum(simulated.values()), r["compositing"]
 
 
+@pytest.mark.mpi
+def test_ranks_read_their_bricks_from_a_file(tmp_path):
+    """Five ranks read their bricks (and ghosts) of a non-cubic, anisotropic NIfTI file through
+    memory maps: radix-k (5, one round), the work-sized split, interleaved bricks and the
+    image partition all equal the serial render of the file as data_gen.load reads it."""
+    data = data_gen.make_field("marschner-lobb").sample((21, 25, 29)).data.astype(np.float32)
+    source = write_volume_files(tmp_path, data, spacing=(1.0, 1.2, 1.5))[1][0]
+    views = [({"azimuth": 35, "elevation": 25}, "catmull-rom")]
+    results = render(5, views, [["radix-k", "even"], ["radix-k", "work"],
+                                ["direct-send", "interleaved"], ["image", None]],
+                     file=str(source))
+    check_results(results)
+    assert all(rss > 0 for r in results for rss in r["peak_rss"])
+
+
 # Rounds of each compositor on 4 ranks (binary swap: no fold, rounds 1 and 2).
 FAILURES = [("direct-send", 2, 0, "before"), ("binary-swap", 3, 2, "after"),
             ("radix-k:2x2", 1, 0, "after"), ("radix-k:2x2", 2, 1, "before"),
@@ -252,6 +267,78 @@ def test_image_partition_in_process_and_from_a_file(tmp_path):
     assert np.abs(frame.image.rgba - serial.rgba).max() < TOLERANCE
 
 
+def write_volume_files(folder, data, spacing=(1.0, 1.0, 1.0)):
+    """``data`` ``[z, y, x]`` as .npy, uncompressed NIfTI (voxel sizes ``spacing``) and raw
+    with a 64-byte header; returns the sources and the serial volume each loads as."""
+    import nibabel
+
+    np.save(folder / "v.npy", data)
+    affine = np.diag([*spacing, 1.0])
+    nibabel.save(nibabel.Nifti1Image(np.ascontiguousarray(data.transpose(2, 1, 0)), affine),
+                 folder / "v.nii")
+    with open(folder / "v.raw", "wb") as f:
+        f.write(b"h" * 64)
+        data.astype("<u2" if data.dtype == np.uint16 else data.dtype).tofile(f)
+    raw = mpi.RawFile(folder / "v.raw", data.shape, data.dtype.name, offset=64)
+    return [(folder / "v.npy", data_gen.load(folder / "v.npy")),
+            (folder / "v.nii", data_gen.load(folder / "v.nii")),
+            (raw, data_gen.load_raw(raw.path, raw.shape, raw.dtype, offset=64))]
+
+
+@pytest.mark.parametrize("dtype", ["float32", "uint16"])
+def test_bricks_read_from_every_file_format_equal_the_serial_render(tmp_path, dtype):
+    """A non-cubic volume as .npy, NIfTI (anisotropic voxels) and raw with a header, read brick
+    by brick through memory maps (four bricks on one rank, and the image partition): each
+    image equals the serial render of the file as data_gen.load reads it, in the same world
+    box and storage type."""
+    field = data_gen.make_field("marschner-lobb")
+    data = field.sample((13, 17, 21)).data
+    if dtype == "uint16":
+        data = np.round(data * 60000).astype(np.uint16)
+    data = data.astype(dtype)
+    view = vrlib.View.orbit(azimuth=35, elevation=25, size=24)
+    transfer = vrlib.Glow(2.0 if dtype == "float32" else 2.0 / 60000)
+    for source, serial_volume in write_volume_files(tmp_path, data, spacing=(1.0, 1.0, 1.5)):
+        assert serial_volume.data.dtype == np.float32
+        serial = vrlib.render(serial_volume, view, transfer=transfer, early_termination=1.0)
+        assert serial.alpha.max() > 0.2
+        for frame in (mpi.render_object(MPI.COMM_SELF, source, view, transfer=transfer,
+                                        compositing="direct-send", balance="interleaved"),
+                      mpi.render_image(MPI.COMM_SELF, source, view, transfer=transfer)):
+            assert np.abs(frame.image.rgba - serial.rgba).max() < TOLERANCE, source
+
+
+def test_bad_files_name_the_problem(tmp_path):
+    view = vrlib.View.orbit(size=8)
+    comm = MPI.COMM_SELF
+    data = np.zeros((5, 6, 7), np.float32)
+    sources = write_volume_files(tmp_path, data)
+    raw = sources[2][0]
+    with pytest.raises(ValueError, match=r"v.raw holds 904 bytes, but shape \(5, 6, 7\) of "
+                                         r"float32 after 100 header bytes needs 940"):
+        mpi.render_object(comm, mpi.RawFile(raw.path, raw.shape, "float32", offset=100), view)
+    nii = (tmp_path / "v.nii").read_bytes()
+    (tmp_path / "cut.nii").write_bytes(nii[:-10])
+    with pytest.raises(ValueError, match="cut.nii holds .* the file is truncated"):
+        mpi.render_object(comm, tmp_path / "cut.nii", view)
+    (tmp_path / "junk.nii").write_bytes(b"not a header" * 40)
+    with pytest.raises(ValueError, match="junk.nii is not a readable NIfTI file"):
+        mpi.render_image(comm, tmp_path / "junk.nii", view)
+    (tmp_path / "junk.npy").write_bytes(b"\x93NUMPY garbage")
+    with pytest.raises(ValueError, match="junk.npy is not a readable .npy file"):
+        mpi.render_object(comm, tmp_path / "junk.npy", view)
+    (tmp_path / "v.nii.gz").write_bytes(b"")
+    with pytest.raises(ValueError, match="v.nii.gz is compressed.*gunzip"):
+        mpi.render_object(comm, tmp_path / "v.nii.gz", view)
+    np.save(tmp_path / "flat.npy", np.zeros((4, 4)))
+    with pytest.raises(ValueError, match=r"flat.npy must hold a 3-D array .* \(4, 4\)"):
+        mpi.render_object(comm, tmp_path / "flat.npy", view)
+    with pytest.raises(ValueError, match="is not a format a rank can read"):
+        mpi.render_object(comm, tmp_path / "v.raw", view)
+    with pytest.raises(ValueError, match=r"shape \(9, 9, 9\) does not match the file's"):
+        mpi.render_object(comm, tmp_path / "v.npy", view, shape=9)
+
+
 def test_bad_arguments_name_the_parameter(tmp_path):
     field = data_gen.make_field("gaussian-blob")
     view = vrlib.View.orbit(size=8)
@@ -271,7 +358,7 @@ def test_bad_arguments_name_the_parameter(tmp_path):
         mpi.render_object(comm, field, view)
     with pytest.raises(TypeError, match="source must be an analytic field"):
         mpi.render_object(comm, np.zeros((4, 4, 4)), view)
-    with pytest.raises(ValueError, match="existing .npy file"):
+    with pytest.raises(ValueError, match="existing file"):
         mpi.render_image(comm, tmp_path / "missing.npy", view)
     bad = tmp_path / "nan.npy"
     data = np.zeros((5, 5, 5))

@@ -14,7 +14,7 @@ from scipy import ndimage
 
 from vrlib import validate
 
-__all__ = ["Volume", "MinMaxPyramid", "DEFAULT_EXTENT", "check_extent"]
+__all__ = ["Volume", "MinMaxPyramid", "DEFAULT_EXTENT", "check_extent", "storage_dtype"]
 
 #: The default world box, ``[[xmin, xmax], [ymin, ymax], [zmin, zmax]]``: the cube [-1, 1]^3.
 DEFAULT_EXTENT = ((-1.0, 1.0), (-1.0, 1.0), (-1.0, 1.0))
@@ -24,6 +24,18 @@ DEFAULT_EXTENT = ((-1.0, 1.0), (-1.0, 1.0), (-1.0, 1.0))
 _EXACT_IN_FLOAT32 = {
     np.dtype(t) for t in ("int8", "uint8", "int16", "uint16", "float16", "float32")
 }
+
+
+def storage_dtype(dtype):
+    """The dtype a volume stores samples of ``dtype`` in: float32 for the types it holds
+    exactly (8- and 16-bit integers, float16, float32), float64 for all others.
+
+    Examples
+    --------
+    >>> storage_dtype("uint16"), storage_dtype("int32")
+    (dtype('float32'), dtype('float64'))
+    """
+    return np.dtype(np.float32 if np.dtype(dtype) in _EXACT_IN_FLOAT32 else np.float64)
 
 
 @dataclass(frozen=True)
@@ -120,7 +132,7 @@ class Volume:
             raise ValueError(
                 f"volume data needs at least 2 samples along every axis, got shape {arr.shape}"
             )
-        storage = np.float32 if arr.dtype in _EXACT_IN_FLOAT32 else np.float64
+        storage = storage_dtype(arr.dtype)
         arr = np.array(arr, dtype=storage, order="C", copy=True if copy else None)
         if not np.all(np.isfinite(arr)):
             bad = int(arr.size - np.count_nonzero(np.isfinite(arr)))

@@ -1,15 +1,15 @@
 """MPI test program: distributed renders against the serial render; rank 0 reports.
 
 Run as ``mpiexec -n P python render.py CONFIG_JSON``. CONFIG holds ``field`` (a data_gen name),
-``params``, ``n`` (samples per axis), ``size`` (image), ``views`` (orbit keyword dicts),
-``filters`` (every view with each, unless a view names its own ``filter``) and ``cases``
-(``[compositing, balance]`` pairs, or ``["image", null]``; ``radix-k:2x3`` is radix-k with
-factors 2, 3); the transfer function is ``Glow(glow)``, or with ``threshold`` a ramp that is
-transparent below it; ``shade`` adds Phong shading and ``gradient_opacity``
-(``[magnitudes, factors]``) a gradient ramp.
+``params``, ``n`` (samples per axis) or ``file`` (a .npy or .nii file read brick by brick
+instead), ``size`` (image), ``views`` (orbit keyword dicts), ``filters`` (every view with
+each, unless a view names its own ``filter``) and ``cases`` (``[compositing, balance]`` pairs,
+or ``["image", null]``; ``radix-k:2x3`` is radix-k with factors 2, 3); the transfer function
+is ``Glow(glow)``, or with ``threshold`` a ramp that is transparent below it; ``shade`` adds
+Phong shading and ``gradient_opacity`` (``[magnitudes, factors]``) a gradient ramp.
 Rank 0 prints one JSON line: per case, the largest difference from the serial render, the
-bytes each rank sent per phase, the rectangles it sent while compositing, and the samples per
-rank.
+bytes each rank sent per phase, the rectangles it sent while compositing, the samples and the
+peak resident memory per rank.
 """
 
 import json
@@ -40,6 +40,10 @@ def main(comm, config):
         t = config["threshold"]
         transfer = vrlib.LookupTransfer(8.0 * np.clip((values - t) / (1 - t), 0.0, 1.0),
                                         **extras)
+    # The source: the field sampled on n^3, or a file (``file``) read brick by brick.
+    source, shape = field, config.get("n")
+    if "file" in config:
+        source, shape = config["file"], None
     results = []
     for orbit in config["views"]:
         orbit = dict(orbit)
@@ -48,14 +52,15 @@ def main(comm, config):
         for filt in filters:
             serial = None
             if comm.Get_rank() == 0:
-                serial = vrlib.render(field.sample(config["n"]), view, filter=filt,
+                volume = field.sample(shape) if shape else data_gen.load(source)
+                serial = vrlib.render(volume, view, filter=filt,
                                       transfer=transfer, early_termination=1.0).rgba
             for compositing, balance in config["cases"]:
                 if compositing == "image":
-                    frame = mpi.render_image(comm, field, view, shape=config["n"],
+                    frame = mpi.render_image(comm, source, view, shape=shape,
                                              filter=filt, transfer=transfer)
                 else:
-                    frame = mpi.render_object(comm, field, view, shape=config["n"],
+                    frame = mpi.render_object(comm, source, view, shape=shape,
                                               filter=filt, transfer=transfer,
                                               compositing=compositor(compositing),
                                               balance=balance)
@@ -68,6 +73,7 @@ def main(comm, config):
                         "bytes": [r["bytes"] for r in frame.ranks],
                         "messages": [r.get("messages", []) for r in frame.ranks],
                         "samples": [r["samples"] for r in frame.ranks],
+                        "peak_rss": [r["peak_rss"] for r in frame.ranks],
                     })
     if comm.Get_rank() == 0:
         print(json.dumps({"size": comm.Get_size(), "results": results}))

@@ -22,6 +22,7 @@ A rank that raises ends the frame on every rank at the next stage boundary
 from __future__ import annotations
 
 import math
+import resource
 import time
 from dataclasses import dataclass, field
 
@@ -36,13 +37,13 @@ from vrlib.parallel.balance import BALANCE, visible_cells, visible_work, work_sp
 from vrlib.parallel.composite import COMPOSITORS, HEADER, Compositor, RadixK, gather_to_root
 from vrlib.parallel.decompose import interleaved_owners, screen_tiles, split
 from vrlib.parallel.exchange import Exchange
-from vrlib.parallel.sources import ghost, global_value_range, open_source
+from vrlib.parallel.sources import RawFile, ghost, global_value_range, open_source
 from vrlib.parallel.stage import RankFailed, Stage
 from vrlib.raycast import cast_rays
 from vrlib.skipping import BLOCK, brick_empty_blocks, coarsen, footprint_mask
 
 __all__ = ["render_object", "render_image", "RankFailed", "Frame", "visible_cells",
-           "work_split", "COMPOSITORS", "RadixK", "BALANCE", "HEADER"]
+           "work_split", "COMPOSITORS", "RadixK", "RawFile", "BALANCE", "HEADER"]
 
 
 @dataclass
@@ -52,7 +53,8 @@ class Frame:
     ``image`` is the composited :class:`vrlib.Image` on the root rank (None elsewhere);
     ``ranks`` (root only) one dict per rank: bricks, samples, seconds rendering and
     compositing, bytes sent per phase (``balance``, ``voxels``, ``composite``,
-    ``gather``), and (object partition) ``messages``, one ``[round, destination, pixels]``
+    ``gather``), the process's peak resident memory (``peak_rss``, bytes), and (object
+    partition) ``messages``, one ``[round, destination, pixels]``
     per rectangle the rank sent while compositing.
 
     Examples
@@ -94,6 +96,11 @@ def _cast(data, first, brick_lo, brick_hi, lattice, view, filt, transfer, ds, va
                      early_termination=1.0, skip=(empty, coarsen(empty), BLOCK, mask))
 
 
+def _peak_rss():
+    """This process's peak resident memory so far, bytes (Linux reports kilobytes)."""
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024
+
+
 def _root(root, size):
     root = validate.positive_int("root", root, minimum=0)
     if root >= size:
@@ -129,10 +136,11 @@ def render_object(comm, source, view, *, shape=None, extent=None, filter="trilin
     Parameters
     ----------
     comm : mpi4py.MPI.Comm
-    source : data_gen field or path to a ``.npy`` file
+    source : data_gen field, path to a ``.npy`` or ``.nii`` file, or RawFile
         A field is sampled on the lattice ``shape`` over ``extent`` (default its bounds), each
         rank evaluating only its brick and ghost samples; a file is memory-mapped and each
-        rank reads only its brick (``extent`` default [-1, 1]^3).
+        rank reads only its brick and ghost samples (``extent`` default: the box
+        :func:`data_gen.load` gives the file; see :mod:`vrlib.parallel.sources`).
     view : vrlib.View
     shape : int or (int, int, int)
         Samples per axis (fields only).
@@ -224,7 +232,7 @@ def render_object(comm, source, view, *, shape=None, extent=None, filter="trilin
     rgba = gather_to_root(comm, rect, finished, view.shape, root, sent)
     stats = {"rank": rank, "bricks": len(bricks), "samples": int(samples),
              "render_s": render_s, "composite_s": composite_s, "bytes": sent,
-             "messages": log}
+             "messages": log, "peak_rss": _peak_rss()}
     ranks = comm.gather(stats, root=root)
     if rank != root:
         return Frame(None)
@@ -319,7 +327,7 @@ def render_image(comm, source, view, *, shape=None, extent=None, filter="triline
             buf = data[tuple(slice(a - r[0], b - r[0]) for (a, b), r in zip(box, region,
                                                                              strict=True))]
         else:
-            buf = np.empty([b - a for a, b in box])
+            buf = np.empty([b - a for a, b in box], dtype=data.dtype)  # one file: one type
             comm.Recv(buf, source=source_rank, tag=11)
         pieces.append((box, buf))
     MPI.Request.Waitall(requests)
@@ -332,7 +340,8 @@ def render_image(comm, source, view, *, shape=None, extent=None, filter="triline
             lo = [min(box[a][0] for box, _ in pieces) for a in range(3)]
             hi = [max(box[a][1] for box, _ in pieces) for a in range(3)]
             # Samples nobody sent are NaN: a ray that read one would show it.
-            local = np.full([h - a for a, h in zip(lo, hi, strict=True)], np.nan)
+            local = np.full([h - a for a, h in zip(lo, hi, strict=True)], np.nan,
+                            dtype=data.dtype)
             for box, buf in pieces:
                 local[tuple(slice(a - o, b - o) for (a, b), o in zip(box, lo,
                                                                      strict=True))] = buf
@@ -348,7 +357,7 @@ def render_image(comm, source, view, *, shape=None, extent=None, filter="triline
         render_s = time.perf_counter() - start
     rgba = gather_to_root(comm, tile, pixels, view.shape, root, sent)
     stats = {"rank": rank, "bricks": 1, "samples": int(samples), "render_s": render_s,
-             "composite_s": 0.0, "bytes": sent}
+             "composite_s": 0.0, "bytes": sent, "peak_rss": _peak_rss()}
     ranks = comm.gather(stats, root=root)
     if rank != root:
         return Frame(None)

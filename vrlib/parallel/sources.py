@@ -1,9 +1,13 @@
 """Where a distributed render's samples come from: each rank reads only its brick.
 
 A source is an analytic field (each rank evaluates its brick and ghost samples,
-:meth:`data_gen.Field.sample_region`) or a ``.npy`` file (memory-mapped; each rank reads its
-brick). Either way the ranks share one global sample lattice (:class:`Lattice`), so bricks
-render on the same ray lattice and join without seams.
+:meth:`data_gen.Field.sample_region`) or a file, memory-mapped so that each rank reads only
+the pages of its brick: ``.npy``, uncompressed NIfTI (``.nii``) or headerless samples
+(:class:`RawFile`). Either way the ranks share one global sample lattice (:class:`Lattice`),
+so bricks render on the same ray lattice and join without seams. A file's world box is
+:func:`data_gen.fitted_extent` of its shape (and voxel sizes), as the serial loaders give it.
+Samples of 8- and 16-bit integers, float16 and float32 are read as float32, others as
+float64, as :class:`vrlib.Volume` stores them, so a brick holds no more than its share.
 """
 
 from __future__ import annotations
@@ -17,8 +21,9 @@ from mpi4py import MPI
 
 from vrlib import validate
 from vrlib.value_bounds import value_bounds
+from vrlib.volume import storage_dtype
 
-__all__ = ["Lattice", "open_source", "ghost", "global_value_range"]
+__all__ = ["Lattice", "RawFile", "open_source", "memory_map", "ghost", "global_value_range"]
 
 
 @dataclass(frozen=True)
@@ -39,8 +44,115 @@ class Lattice:
                 self.origin + np.array(hi[::-1]) * self.spacing)
 
 
+@dataclass(frozen=True)
+class RawFile:
+    """Headerless samples in a file, ``shape = (nz, ny, nx)``, x varying fastest (as
+    :func:`data_gen.load_raw` reads them).
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> f = pathlib.Path(tempfile.mkdtemp()) / "v.raw"
+    >>> np.arange(27, dtype=np.uint8).tofile(f)
+    >>> array, extent = memory_map(RawFile(f, (3, 3, 3), "uint8"))
+    >>> int(array[2, 1, 0]), extent.tolist()[0]
+    (21, [-1.0, 1.0])
+    """
+
+    path: str | Path
+    shape: tuple
+    dtype: str
+    offset: int = 0
+    byteorder: str = "little"
+
+
+def memory_map(source):
+    """A file source's samples ``[z, y, x]``, memory-mapped (nothing is read until indexed),
+    its world box, and the scaling ``(slope, intercept)`` its values take (NIfTI), or None.
+
+    Raises ValueError naming the problem for a missing, truncated or unreadable file, a
+    compressed NIfTI (which cannot be mapped) or an array that is not 3-D.
+    """
+    from data_gen import fitted_extent
+
+    if isinstance(source, RawFile):
+        path = _file(source.path)
+        shape = tuple(validate.positive_int("shape", n, minimum=2) for n in source.shape)
+        if len(shape) != 3:
+            raise ValueError(f"shape must be (nz, ny, nx), got {shape!r}")
+        validate.choice("byteorder", source.byteorder, ("little", "big"))
+        dtype = np.dtype(source.dtype).newbyteorder("<" if source.byteorder == "little"
+                                                    else ">")
+        offset = validate.positive_int("offset", source.offset, minimum=0)
+        _check_size(path, offset + math.prod(shape) * dtype.itemsize, shape, dtype, offset)
+        array = np.memmap(path, dtype=dtype, mode="r", offset=offset, shape=shape)
+        return array, fitted_extent(shape), None
+    path = _file(source)
+    name = path.name.lower()
+    if name.endswith(".npy"):
+        try:
+            array = np.load(path, mmap_mode="r", allow_pickle=False)
+        except (ValueError, OSError, EOFError) as error:
+            raise ValueError(f"source {path.name} is not a readable .npy file: {error}") \
+                from None
+        _check_3d(path, array.shape)
+        return array, fitted_extent(array.shape), None
+    if name.endswith(".nii"):
+        return _map_nifti(path, fitted_extent)
+    if name.endswith(".nii.gz"):
+        raise ValueError(f"source {path.name} is compressed, and each rank must read only its "
+                         "brick from the file: decompress it (gunzip) to a .nii file")
+    raise ValueError(f"source {path.name} is not a format a rank can read its brick from: use "
+                     ".npy, .nii or vrlib.parallel.sources.RawFile(path, shape, dtype)")
+
+
+def _file(path):
+    path = Path(path)
+    if not path.is_file():
+        raise ValueError(f"source must be an analytic field or an existing file (.npy, .nii, "
+                         f"RawFile), got {str(path)!r}")
+    return path
+
+
+def _check_size(path, expected, shape, dtype, offset):
+    actual = path.stat().st_size
+    if actual < expected:
+        raise ValueError(f"source {path.name} holds {actual} bytes, but shape {shape} of "
+                         f"{dtype.name} after {offset} header bytes needs {expected}: the file "
+                         "is truncated or the shape is wrong")
+
+
+def _check_3d(path, shape):
+    if len(shape) != 3 or min(shape) < 2:
+        raise ValueError(f"source {path.name} must hold a 3-D array with at least 2 samples "
+                         f"per axis, got shape {tuple(shape)}")
+
+
+def _map_nifti(path, fitted_extent):
+    """An uncompressed NIfTI file's voxels (i fastest on disk: ``[k, j, i]`` = ``[z, y, x]``,
+    as :func:`data_gen.load_nifti` orders them)."""
+    import nibabel
+
+    try:
+        image = nibabel.load(path)
+        proxy, header = image.dataobj, image.header
+        dtype, offset = np.dtype(proxy.dtype), int(proxy.offset)
+        shape = tuple(int(n) for n in proxy.shape)
+        slope, intercept = float(proxy.slope), float(proxy.inter)
+    except Exception as error:  # nibabel raises many kinds on a corrupt header
+        raise ValueError(f"source {path.name} is not a readable NIfTI file: {error}") from None
+    if len(shape) == 4 and shape[3] == 1:
+        shape = shape[:3]
+    _check_3d(path, shape)
+    _check_size(path, offset + math.prod(shape) * dtype.itemsize, shape, dtype, offset)
+    array = np.memmap(path, dtype=dtype, mode="r", offset=offset, shape=shape[::-1])
+    scaling = None if (slope, intercept) == (1.0, 0.0) else (slope, intercept)
+    spacing = np.asarray(header.get_zooms()[:3], dtype=np.float64)
+    return array, fitted_extent(array.shape, spacing), scaling
+
+
 def open_source(source, shape, extent):
-    """The lattice and a reader ``read(region) -> ndarray`` of a field or a ``.npy`` file.
+    """The lattice and a reader ``read(region) -> ndarray`` of a field or a file.
 
     ``region`` is a ``(start, stop)`` pair of sample indices per axis (z, y, x).
 
@@ -51,24 +163,23 @@ def open_source(source, shape, extent):
     >>> lattice.shape, read([(0, 2), (0, 5), (4, 5)]).shape
     ((5, 5, 5), (2, 5, 1))
     """
-    if isinstance(source, str | Path):
-        path = Path(source)
-        if path.suffix != ".npy" or not path.is_file():
-            raise ValueError(f"source must be an analytic field or an existing .npy file, got "
-                             f"{str(path)!r}")
-        array = np.load(path, mmap_mode="r")
-        if array.ndim != 3 or min(array.shape) < 2:
-            raise ValueError(f"source {path.name} must hold a 3-D array with at least 2 "
-                             f"samples per axis, got shape {array.shape}")
-        if shape is not None and tuple(shape) != array.shape:
-            raise ValueError(f"shape {tuple(shape)} does not match the file's {array.shape}")
+    if isinstance(source, str | Path | RawFile):
+        array, ext, scaling = memory_map(source)
+        name = Path(source.path if isinstance(source, RawFile) else source).name
+        if shape is not None:
+            wanted = tuple(int(n) for n in np.broadcast_to(shape, 3))
+            if wanted != array.shape:
+                raise ValueError(f"shape {wanted} does not match the file's {array.shape}")
         shape = array.shape
-        ext = np.array([[-1.0, 1.0]] * 3) if extent is None else np.asarray(extent, float)
+        ext = ext if extent is None else np.asarray(extent, float)
+        storage = np.float64 if scaling is not None else storage_dtype(array.dtype)
 
         def read(region):
-            block = np.array(array[tuple(slice(a, b) for a, b in region)], dtype=np.float64)
+            block = np.array(array[tuple(slice(a, b) for a, b in region)], dtype=storage)
+            if scaling is not None:
+                block = block * scaling[0] + scaling[1]
             if not np.all(np.isfinite(block)):
-                raise ValueError(f"source {path.name} holds NaN or infinite samples")
+                raise ValueError(f"source {name} holds NaN or infinite samples")
             return block
     elif callable(getattr(source, "sample_region", None)):
         if shape is None:
@@ -81,8 +192,8 @@ def open_source(source, shape, extent):
         def read(region):
             return source.sample_region(shape, region, extent=ext)
     else:
-        raise TypeError(f"source must be an analytic field (data_gen.make_field) or a path to "
-                        f".npy samples, got {type(source).__name__}")
+        raise TypeError(f"source must be an analytic field (data_gen.make_field), a path to a "
+                        f".npy or .nii file, or a RawFile, got {type(source).__name__}")
     origin = ext[:, 0].copy()
     spacing = (ext[:, 1] - ext[:, 0]) / (np.array(shape[::-1]) - 1)
     return Lattice(tuple(shape), origin, spacing), read
