@@ -73,6 +73,36 @@ def test_object_partition_costs_order_as_derived():
     assert cauchy == sorted(cauchy)
 
 
+@pytest.mark.claim(4, "supports")
+def test_every_row_of_the_taxonomy_is_counted_and_orders_as_derived():
+    """Every class of the taxonomy, simulated for one frame on 16 nodes (dynamic object
+    partitions re-cut for a moving scene, dynamic image partitions for a 2 degree turn): each
+    sends something, interleaving costs more than the contiguous layout in every class (image
+    tiles: every node's tiles see nearly the whole volume; object bricks: more, smaller
+    fragments), and a re-cut object partition moves voxels on top of its fragments."""
+    nodes, n = 16, 65
+    view = View.orbit(azimuth=30, elevation=20, size=128)
+    after = View.orbit(azimuth=32, elevation=20, size=128)
+    field = data_gen.make_field("random-blobs", count=6, seed=7)
+    work = [(field.sample(64, extent=[[-1 + s, 1 + s]] * 3).data > 0.25) + 0.01
+            for s in (0.0, 0.1)]  # the scene moves along the diagonal
+    totals = {}
+    for p in taxonomy.TAXONOMY:
+        msgs = taxonomy.frame(p, nodes, n, view, after=after, work=work, interleave=4)
+        assert msgs.total > 0, p.name
+        totals[(p.space, p.shape, p.layout, p.schedule)] = msgs
+    for (space, shape, layout, schedule), msgs in totals.items():
+        if layout == "interleaved":
+            assert msgs.total > totals[(space, shape, "contiguous", schedule)].total
+    # The static image partition's interleaved tiles need most of the volume on every node.
+    per_node = totals[("image", "tiles", "interleaved", "static")].sent_per_node(nodes)
+    assert per_node.sum() > 0.5 * (nodes - 1) * n**3 / nodes
+    for shape in ("slabs", "shafts", "blocks"):
+        p = taxonomy.Partition("object", shape, "contiguous", "dynamic")
+        still = taxonomy.frame(p, nodes, n, view, work=[work[1], work[1]]).total
+        assert totals[("object", shape, "contiguous", "dynamic")].total > still  # migration
+
+
 def imbalance(work):
     work = np.asarray(work, dtype=float)
     return float(work.max() / work.mean())

@@ -212,9 +212,12 @@ def split(cells, parts, *, shape="blocks", weights=None, grid=None, groups=None)
         if math.prod(grid) != parts:
             raise ValueError(f"grid {tuple(grid)} holds {math.prod(grid)} bricks, not {parts}")
         axes = (0, 1, 2)
+    if grid is not None and any(g > c for g, c in zip(grid, cells, strict=True)):
+        raise ValueError(f"cannot cut {cells} cells into a {tuple(grid)} grid of {shape}: at "
+                         "most one brick per cell along each axis; use fewer parts or a larger "
+                         "volume")
     capacity = math.prod(cells[a] for a in axes) if grid is None else parts
-    if parts > capacity or (grid is not None and any(g > c for g, c in zip(grid, cells,
-                                                                             strict=True))):
+    if parts > capacity:
         raise ValueError(
             f"cannot split {cells} cells into {parts} {shape} (at most {capacity}): use "
             "fewer parts or a larger volume"
@@ -250,7 +253,15 @@ def split(cells, parts, *, shape="blocks", weights=None, grid=None, groups=None)
             open_axes = [a for a in axes if hi[a] - lo[a] > 1]
             axis = max(open_axes, key=lambda a: (hi[a] - lo[a], -a))
             left_n = left_count(n)
-            position = _cut(lo, hi, axis, left_n / n, weights)
+            # Each side keeps enough cells for its bricks.
+            across = math.prod(hi[a] - lo[a] for a in axes if a != axis)
+            least = (-(-left_n // across), -(-(n - left_n) // across))
+            if sum(least) > hi[axis] - lo[axis]:
+                box = tuple(h - low for low, h in zip(lo, hi, strict=True))
+                raise ValueError(f"cannot split {cells} cells into {parts} {shape}: a box of "
+                                 f"{box} cells cannot hold {left_n} + {n - left_n} bricks of "
+                                 "whole cells; use fewer parts or a larger volume")
+            position = _cut(lo, hi, axis, left_n / n, weights, least)
             sub_left = sub_right = None
         left_hi, right_lo = list(hi), list(lo)
         left_hi[axis] = right_lo[axis] = position
@@ -262,10 +273,10 @@ def split(cells, parts, *, shape="blocks", weights=None, grid=None, groups=None)
     return KdTree(tuple(bricks), node)
 
 
-def _cut(lo, hi, axis, fraction, weights):
+def _cut(lo, hi, axis, fraction, weights, least=(1, 1)):
     """Cell position along ``axis`` that leaves ``fraction`` of the work (or of the cells)
-    below it, keeping at least one cell on each side."""
-    first, last = lo[axis] + 1, hi[axis] - 1
+    below it, keeping at least ``least`` cells below and above."""
+    first, last = lo[axis] + max(least[0], 1), hi[axis] - max(least[1], 1)
     if weights is None:
         return min(max(lo[axis] + round((hi[axis] - lo[axis]) * fraction), first), last)
     box = weights[lo[0]:hi[0], lo[1]:hi[1], lo[2]:hi[2]]
@@ -331,8 +342,8 @@ def screen_tiles(height, width, nodes, *, layout="contiguous", tile=16):
 
     ``"contiguous"``: one rectangle per node, in a grid as square as the count allows (rows
     of tiles top to bottom, row-major owners). ``"interleaved"``: square tiles of ``tile``
-    pixels dealt round-robin along a diagonal, so each node's tiles are spread over the whole
-    screen.
+    pixels dealt round-robin row by row, each row shifted by one, so each node's tiles are
+    spread over the whole screen.
 
     Examples
     --------
@@ -364,7 +375,8 @@ def screen_tiles(height, width, nodes, *, layout="contiguous", tile=16):
         rows = np.unique(np.minimum(np.arange(0, height + tile, tile), height))
         cols = np.unique(np.minimum(np.arange(0, width + tile, tile), width))
         i, j = np.meshgrid(np.arange(len(rows) - 1), np.arange(len(cols) - 1), indexing="ij")
-        owner = (i + j) % nodes
+        # Round-robin along rows, each row shifted by one more: no node's tiles line up.
+        owner = (i * len(cols) + j) % nodes
         if len(np.unique(owner)) < nodes:
             raise ValueError(f"{nodes} nodes for {owner.size} tiles of {tile} pixels: use "
                              "smaller tiles or fewer nodes")

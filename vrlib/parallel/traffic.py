@@ -19,7 +19,7 @@ import numpy as np
 from vrlib.parallel.rects import area
 
 __all__ = ["Messages", "sum_messages", "footprint_rect", "gather", "image_static",
-           "image_dynamic"]
+           "image_dynamic", "migration"]
 
 #: Most voxels projected when counting an image partition's traffic; larger volumes are
 #: counted on a sub-lattice whose every voxel stands for ``stride^3`` of them.
@@ -255,3 +255,35 @@ def image_dynamic(tiles, before, after, sample_shape, origin, spacing, *, bytes_
         size.append(np.full(owner[0].size, float(stride**3 * bytes_per_voxel)))
     return Messages.merged(np.concatenate(src), np.concatenate(dst), np.concatenate(size),
                            nodes)
+
+
+def migration(before, before_owners, after, after_owners, *, bytes_per_cell=1.0):
+    """An object partition re-cut between frames: every cell whose brick changes owner moves,
+    from the owner of the brick that held it to the owner of the brick that holds it now.
+    ``before`` and ``after`` are lists of :class:`~vrlib.parallel.decompose.Brick` tiling the
+    same box of cells (counted cell by cell, so the box should be at most a few ten million
+    cells: a coarse lattice whose cells stand for many samples, ``bytes_per_cell`` each).
+
+    Examples
+    --------
+    >>> from vrlib.parallel.decompose import split
+    >>> a, b = split((8, 8, 8), 2), split((8, 8, 8), 2, weights=np.ones((8, 8, 8)) *
+    ...                                  (np.arange(8) < 2)[:, None, None] + 0.01)
+    >>> [x.hi[0] for x in a.bricks], [x.hi[0] for x in b.bricks]   # the cut moves 4 -> 1
+    ([4, 8], [1, 8])
+    >>> migration(a.bricks, [0, 1], b.bricks, [0, 1]).bytes.tolist()  # 3 slices of 64 cells
+    [192.0]
+    """
+    cells = tuple(max(b.hi[a] for b in before) for a in range(3))
+    owners = []
+    for bricks, owner in ((before, before_owners), (after, after_owners)):
+        label = np.empty(cells, dtype=np.int64)
+        for brick, node in zip(bricks, owner, strict=True):
+            label[brick.lo[0]:brick.hi[0], brick.lo[1]:brick.hi[1],
+                  brick.lo[2]:brick.hi[2]] = node
+        owners.append(label)
+    nodes = int(max(np.max(before_owners), np.max(after_owners))) + 1
+    moved = owners[0] != owners[1]
+    pairs = np.bincount(owners[0][moved] * nodes + owners[1][moved], minlength=nodes * nodes)
+    key = np.flatnonzero(pairs)
+    return Messages(key // nodes, key % nodes, pairs[key] * float(bytes_per_cell))
