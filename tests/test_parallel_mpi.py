@@ -22,7 +22,7 @@ MPIEXEC = Path(sys.executable).parent / "mpiexec"
 # Every compositor with even bricks, then the other balances and the image partition.
 CASES = [[name, "even"] for name in composite.COMPOSITORS] + [
     ["direct-send", "interleaved"], ["binary-swap", "work"], ["radix-k", "work"],
-    ["image", None]]
+    ["image", None], ["image-interleaved", None]]
 # Radix-k factorisations besides the default (radix_factors), per rank count.
 FACTORS = {4: ["2x2"], 6: ["2x3", "3x2"], 8: ["2x2x2", "2x4"], 9: ["3x3"], 10: ["2x5", "5x2"],
            12: ["3x4", "2x2x3", "2x6"]}
@@ -228,7 +228,7 @@ def test_a_rank_killed_by_a_signal_ends_the_job_and_writes_nothing(tmp_path):
 # ---------------------------------------------------------------- in this process
 
 
-@pytest.mark.parametrize("compositing,balance", [c for c in CASES if c[0] != "image"])
+@pytest.mark.parametrize("compositing,balance", [c for c in CASES if not c[0].startswith("image")])
 def test_one_rank_in_process_equals_serial(compositing, balance):
     field = data_gen.make_field("marschner-lobb")
     view = vrlib.View.orbit(azimuth=35, elevation=25, size=24)
@@ -257,14 +257,16 @@ def test_shaded_bricks_in_process_equal_serial(projection):
 
 
 def test_image_partition_in_process_and_from_a_file(tmp_path):
-    """The image partition on one rank, reading a memory-mapped .npy file."""
+    """The image partition on one rank, contiguous and interleaved (tiles of 5 pixels, the
+    last ones cut by the image's edge), reading a memory-mapped .npy file."""
     vol = data_gen.make_field("gaussian-blob", sigma=0.4).sample(17)
     path = tmp_path / "blob.npy"
     np.save(path, vol.data)
     view = vrlib.View.orbit(azimuth=-20, elevation=40, size=24, projection="perspective")
-    frame = mpi.render_image(MPI.COMM_SELF, path, view)
     serial = vrlib.render(vol, view, early_termination=1.0)
-    assert np.abs(frame.image.rgba - serial.rgba).max() < TOLERANCE
+    for layout in ("contiguous", "interleaved"):
+        frame = mpi.render_image(MPI.COMM_SELF, path, view, layout=layout, tile=5)
+        assert np.abs(frame.image.rgba - serial.rgba).max() < TOLERANCE
 
 
 def write_volume_files(folder, data, spacing=(1.0, 1.0, 1.0)):

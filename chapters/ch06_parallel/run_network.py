@@ -9,8 +9,8 @@ frame are built from the real partition and three views (:func:`vrlib.parallel.t
 (:mod:`vrlib.parallel.network`), and the busiest, mean and bisection channel loads are
 recorded, averaged over the views. Dynamic object partitions re-cut their k-d tree each frame
 to follow the work of a scene that moves (six random blobs, translated along the diagonal by
-``SHIFT`` of the box's side per frame, work counted on a ``WORK_GRID^3`` lattice). Power laws ``load ~ P^e`` are fitted per
-class. Writes ``build/results/ch06_parallel/network.json``.
+``SHIFT`` of the box's side per frame, work counted on a ``WORK_GRID^3`` lattice). Power laws
+``load ~ P^e`` are fitted per class. Writes ``build/results/ch06_parallel/network.json``.
 """
 
 import math

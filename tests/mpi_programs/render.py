@@ -4,7 +4,8 @@ Run as ``mpiexec -n P python render.py CONFIG_JSON``. CONFIG holds ``field`` (a 
 ``params``, ``n`` (samples per axis) or ``file`` (a .npy or .nii file read brick by brick
 instead), ``size`` (image), ``views`` (orbit keyword dicts), ``filters`` (every view with
 each, unless a view names its own ``filter``) and ``cases`` (``[compositing, balance]`` pairs,
-or ``["image", null]``; ``radix-k:2x3`` is radix-k with factors 2, 3); the transfer function
+or ``["image", null]``, ``["image-interleaved", null]`` for 8-pixel tiles dealt round-robin;
+``radix-k:2x3`` is radix-k with factors 2, 3); the transfer function
 is ``Glow(glow)``, or with ``threshold`` a ramp that is transparent below it; ``shade`` adds
 Phong shading and ``gradient_opacity`` (``[magnitudes, factors]``) a gradient ramp.
 Rank 0 prints one JSON line: per case, the largest difference from the serial render, the
@@ -56,9 +57,11 @@ def main(comm, config):
                 serial = vrlib.render(volume, view, filter=filt,
                                       transfer=transfer, early_termination=1.0).rgba
             for compositing, balance in config["cases"]:
-                if compositing == "image":
-                    frame = mpi.render_image(comm, source, view, shape=shape,
-                                             filter=filt, transfer=transfer)
+                if compositing.startswith("image"):
+                    layout = "interleaved" if compositing == "image-interleaved" else \
+                        "contiguous"
+                    frame = mpi.render_image(comm, source, view, shape=shape, filter=filt,
+                                             transfer=transfer, layout=layout, tile=8)
                 else:
                     frame = mpi.render_object(comm, source, view, shape=shape,
                                               filter=filt, transfer=transfer,

@@ -594,16 +594,17 @@ COMPOSITORS = {c.name: c for c in (DirectSend(), BinarySwap(), RadixK())}
 # ---------------------------------------------------------------- the finished image
 
 
-def gather_to_root(comm, rect, finished, shape, root, sent):
-    """Each rank's finished rectangle to ``root``; the full image there."""
-    payload = (rect, finished if not is_empty(rect) else None)
-    if comm.Get_rank() != root and not is_empty(rect):
-        sent["gather"] += HEADER + finished.nbytes
-    parts = comm.gather(payload, root=root)
+def gather_to_root(comm, parts, shape, root, sent):
+    """Each rank's finished rectangles ``[(rect, pixels), ...]`` to ``root``; the full image
+    there (None elsewhere)."""
+    parts = [(rect, buf) for rect, buf in parts if not is_empty(rect)]
+    if comm.Get_rank() != root:
+        sent["gather"] += sum(HEADER + buf.nbytes for _, buf in parts)
+    gathered = comm.gather(parts, root=root)
     if comm.Get_rank() != root:
         return None
     out = np.zeros(shape + (4,))
-    for part, buf in parts:
-        if not is_empty(part):
-            out[part[0]:part[1], part[2]:part[3]] = buf
+    for rank_parts in gathered:
+        for rect, buf in rank_parts:
+            out[rect[0]:rect[1], rect[2]:rect[3]] = buf
     return out

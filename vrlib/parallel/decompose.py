@@ -342,8 +342,8 @@ def screen_tiles(height, width, nodes, *, layout="contiguous", tile=16):
 
     ``"contiguous"``: one rectangle per node, in a grid as square as the count allows (rows
     of tiles top to bottom, row-major owners). ``"interleaved"``: square tiles of ``tile``
-    pixels dealt round-robin row by row, each row shifted by one, so each node's tiles are
-    spread over the whole screen.
+    pixels dealt round-robin in row order (each row shifted by one when it holds a multiple of
+    the node count), so each node's tiles are spread over the whole screen.
 
     Examples
     --------
@@ -375,8 +375,10 @@ def screen_tiles(height, width, nodes, *, layout="contiguous", tile=16):
         rows = np.unique(np.minimum(np.arange(0, height + tile, tile), height))
         cols = np.unique(np.minimum(np.arange(0, width + tile, tile), width))
         i, j = np.meshgrid(np.arange(len(rows) - 1), np.arange(len(cols) - 1), indexing="ij")
-        # Round-robin along rows, each row shifted by one more: no node's tiles line up.
-        owner = (i * len(cols) + j) % nodes
+        # Round-robin in row order; when a row holds a multiple of the node count, each row
+        # shifts by one, so that no node's tiles line up in columns.
+        columns = len(cols) - 1
+        owner = (i * columns + j + (i if columns % nodes == 0 else 0)) % nodes
         if len(np.unique(owner)) < nodes:
             raise ValueError(f"{nodes} nodes for {owner.size} tiles of {tile} pixels: use "
                              "smaller tiles or fewer nodes")

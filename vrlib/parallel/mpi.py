@@ -229,7 +229,7 @@ def render_object(comm, source, view, *, shape=None, extent=None, filter="trilin
     with Exchange(comm, compositor.name, sent, log) as exchange:
         rect, finished = compositor.composite(exchange, held, tree, owners, order, view)
     composite_s = time.perf_counter() - start
-    rgba = gather_to_root(comm, rect, finished, view.shape, root, sent)
+    rgba = gather_to_root(comm, [(rect, finished)], view.shape, root, sent)
     stats = {"rank": rank, "bricks": len(bricks), "samples": int(samples),
              "render_s": render_s, "composite_s": composite_s, "bytes": sent,
              "messages": log, "peak_rss": _peak_rss()}
@@ -245,9 +245,9 @@ def render_object(comm, source, view, *, shape=None, extent=None, filter="trilin
     return Frame(image, ranks)
 
 
-def _needed(view, lattice, region, tile, reach):
+def _needed(view, lattice, region, tiles, reach):
     """Index box (per axis ``(start, stop)``) of the samples in ``region`` that rays through
-    the pixels of ``tile`` can read, or None."""
+    the pixels of any of ``tiles`` (pixel rectangles) can read, or None."""
     axes = [np.arange(a, b) for a, b in region]
     z, y, x = np.meshgrid(*axes, indexing="ij")
     points = np.stack([x, y, z], axis=-1).reshape(-1, 3) * lattice.spacing + lattice.origin
@@ -259,9 +259,10 @@ def _needed(view, lattice, region, tile, reach):
         slope = 1.0 + unit * math.hypot(view.height, view.width) / 2.0
         rho = reach * slope / (unit * np.maximum(p[:, 2] - reach, 1e-12))
     rho = rho * (1.0 + 1e-9) + 1e-9
-    r0, r1, c0, c1 = tile
-    hit = (p[:, 0] + rho >= r0 + 0.5) & (p[:, 0] - rho <= r1 - 0.5)
-    hit &= (p[:, 1] + rho >= c0 + 0.5) & (p[:, 1] - rho <= c1 - 0.5)
+    hit = np.zeros(p.shape[0], dtype=bool)
+    for r0, r1, c0, c1 in tiles:
+        hit |= ((p[:, 0] + rho >= r0 + 0.5) & (p[:, 0] - rho <= r1 - 0.5) &
+                (p[:, 1] + rho >= c0 + 0.5) & (p[:, 1] - rho <= c1 - 0.5))
     if view.is_perspective:
         hit |= ~np.isfinite(p[:, 0]) | (p[:, 2] - reach <= 0.0)
     if not hit.any():
@@ -272,14 +273,18 @@ def _needed(view, lattice, region, tile, reach):
 
 
 def render_image(comm, source, view, *, shape=None, extent=None, filter="trilinear",
-                 transfer=None, step=0.5, root=0):
+                 transfer=None, step=0.5, layout="contiguous", tile=16, root=0):
     """Render ``source`` with an image partition over the ranks of ``comm``.
 
-    The volume stays where it is loaded, one brick per rank (no ghosts); each rank owns one
-    screen tile and receives from every rank the box of samples its tile's rays can read
-    (within the filter's reach of the tile), assembles them, and ray-casts its tile.
-    Arguments as :func:`render_object`. Returns a :class:`Frame` whose ranks count the voxel
-    traffic under ``bytes["voxels"]``.
+    The volume stays where it is loaded, one brick per rank (no ghosts); each rank owns
+    screen tiles and receives from every rank the box of samples its tiles' rays can read
+    (within the filter's reach of a tile), assembles them, and ray-casts its tiles. With
+    ``layout="contiguous"`` each rank owns one rectangle; with ``"interleaved"`` square tiles
+    of ``tile`` pixels are dealt round-robin
+    (:func:`vrlib.parallel.decompose.screen_tiles`), which spreads the work of a scene whose
+    content is off-centre, at the price of receiving the samples behind the whole screen.
+    Other arguments as :func:`render_object`. Returns a :class:`Frame` whose ranks count the
+    voxel traffic under ``bytes["voxels"]``.
 
     Examples
     --------
@@ -295,10 +300,11 @@ def render_image(comm, source, view, *, shape=None, extent=None, filter="triline
     sent = {"balance": 0, "voxels": 0, "composite": 0, "gather": 0}
     with Stage(comm, "checking the arguments"):
         filt, transfer, step, _ = _check(view, filter, transfer, step)
+        validate.choice("layout", layout, ("contiguous", "interleaved"))
         root = _root(root, size)
         lattice, read = open_source(source, shape, extent)
         tree = split(lattice.cells, size)
-        tiles = screen_tiles(view.height, view.width, size)
+        tiles = screen_tiles(view.height, view.width, size, layout=layout, tile=tile)
     ds = step * float(lattice.spacing.min())
     with Stage(comm, "reading its brick"):
         brick = tree.bricks[rank]
@@ -308,7 +314,7 @@ def render_image(comm, source, view, *, shape=None, extent=None, filter="triline
     value_range = global_value_range(comm, [float(data.min())], [float(data.max())], filt)
     with Stage(comm, "finding the voxels each tile needs"):
         reach = filt.radius * float(np.linalg.norm(lattice.spacing))
-        boxes = [_needed(view, lattice, region, tiles.rects(d)[0], reach) for d in range(size)]
+        boxes = [_needed(view, lattice, region, tiles.rects(d), reach) for d in range(size)]
     incoming = comm.alltoall(boxes)
     sent["voxels"] += HEADER * (size - 1)
     requests = []
@@ -331,11 +337,11 @@ def render_image(comm, source, view, *, shape=None, extent=None, filter="triline
             comm.Recv(buf, source=source_rank, tag=11)
         pieces.append((box, buf))
     MPI.Request.Waitall(requests)
-    with Stage(comm, "rendering its tile"):
+    with Stage(comm, "rendering its tiles"):
         start = time.perf_counter()
-        tile = tiles.rects(rank)[0]
+        mine = tiles.rects(rank)
         samples = 0
-        pixels = np.zeros((tile[1] - tile[0], tile[3] - tile[2], 4))
+        rgba = np.zeros(view.shape + (4,))
         if pieces:
             lo = [min(box[a][0] for box, _ in pieces) for a in range(3)]
             hi = [max(box[a][1] for box, _ in pieces) for a in range(3)]
@@ -346,16 +352,17 @@ def render_image(comm, source, view, *, shape=None, extent=None, filter="triline
                 local[tuple(slice(a - o, b - o) for (a, b), o in zip(box, lo,
                                                                      strict=True))] = buf
             mask = np.zeros(view.shape, dtype=bool)
-            mask[tile[0]:tile[1], tile[2]:tile[3]] = True
+            for r0, r1, c0, c1 in mine:
+                mask[r0:r1, c0:c1] = True
             skip_grid = np.zeros([-(-c // BLOCK) for c in lattice.cells], dtype=bool)
             rgba, samples = cast_rays(
                 local, offset=tuple(lo), global_shape=lattice.shape, origin=lattice.origin,
                 spacing=lattice.spacing, box=lattice.box((0, 0, 0), lattice.cells), view=view,
                 filt=filt, transfer=transfer, ds=ds, value_range=value_range,
                 early_termination=1.0, skip=(skip_grid, coarsen(skip_grid), BLOCK, mask))
-            pixels = rects.pixels(rgba, tile)
         render_s = time.perf_counter() - start
-    rgba = gather_to_root(comm, tile, pixels, view.shape, root, sent)
+    rgba = gather_to_root(comm, [(r, rects.pixels(rgba, r)) for r in mine], view.shape, root,
+                          sent)
     stats = {"rank": rank, "bricks": 1, "samples": int(samples), "render_s": render_s,
              "composite_s": 0.0, "bytes": sent, "peak_rss": _peak_rss()}
     ranks = comm.gather(stats, root=root)
