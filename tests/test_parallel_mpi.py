@@ -30,7 +30,7 @@ TOLERANCE = 1e-6  # the issue's; measured differences are below 1e-15
 # Orthographic with the trilinear filter, perspective with Catmull-Rom (wider ghosts).
 VIEWS = [({"azimuth": 35, "elevation": 25}, "trilinear"),
          ({"azimuth": -120, "elevation": -40, "projection": "perspective"}, "catmull-rom")]
-FAST_RANKS = (1, 3, 6, 12)
+FAST_RANKS = (1, 3, 6)
 
 
 def launch(program, ranks, *args, timeout=120):
@@ -67,9 +67,9 @@ def test_every_rank_count_equals_the_serial_render(ranks):
     """Object partition (direct send, binary swap, radix-k with its default and other
     factorisations, interleaved and work-balanced bricks) and image partition, orthographic
     and perspective: the composited image equals the serial render's to 1e-6, so bricks join
-    without seams, for every rank count from 1 to 12. ``make test`` runs 1, 3, 6 and 12 (odd,
-    a fold for binary swap, two radix-k rounds of different k, a prime factor of 3); the rest
-    run in ``make test-all`` (slow on two cores)."""
+    without seams, for every rank count from 1 to 12. ``make test`` runs 1, 3 and 6 (odd, a
+    fold for binary swap, radix-k in one round of 3 and in two rounds of 2 and 3 either way
+    round); the rest run in ``make test-all`` (slow on two cores)."""
     cases = CASES + [[f"radix-k:{f}", "even"] for f in FACTORS.get(ranks, [])]
     results = render(ranks, VIEWS, cases)
     assert len(results) == len(cases) * len(VIEWS)
@@ -98,7 +98,7 @@ def test_ranks_with_nothing_to_show_take_part():
     send headers only (empty rectangles); under binary swap and radix-k they still pass on
     what their partners gave them."""
     view = {"azimuth": 5, "elevation": 5, "zoom": 6.0, "center": [0.7, 0.7, 0.7]}
-    results = render(8, [(view, "trilinear")], CASES, size=32)
+    results = render(8, [(view, "trilinear")], CASES[:len(composite.COMPOSITORS)], size=32)
     check_results(results)
     for r in results[:len(composite.COMPOSITORS)]:  # one brick per rank, cut evenly
         idle = [i for i, s in enumerate(r["samples"]) if s == 0]
@@ -162,7 +162,8 @@ def test_ranks_read_their_bricks_from_a_file(tmp_path):
 
 # Rounds of each compositor on 4 ranks (binary swap: no fold, rounds 1 and 2).
 FAILURES = [("direct-send", 2, 0, "before"), ("binary-swap", 3, 2, "after"),
-            ("radix-k:2x2", 1, 0, "after"), ("radix-k:2x2", 2, 1, "before"),
+            ("radix-k:2x2", 2, 1, "before"),
+            pytest.param("radix-k:2x2", 1, 0, "after", marks=pytest.mark.slow),
             pytest.param("binary-swap", 1, 1, "before", marks=pytest.mark.slow),
             pytest.param("binary-swap", 2, 2, "before", marks=pytest.mark.slow),
             pytest.param("radix-k", 3, 0, "before", marks=pytest.mark.slow),
@@ -210,17 +211,16 @@ def test_a_failure_inside_a_compositing_round_ends_the_job(spec, rank, round, wh
 
 @pytest.mark.mpi
 def test_a_rank_killed_by_a_signal_ends_the_job_and_writes_nothing(tmp_path):
-    """Rank 2 is killed (SIGKILL) in the second radix-k round while the others wait on it:
+    """Rank 2 of 3 is killed (SIGKILL) in a radix-k round while the others wait on it:
     mpiexec ends the job within seconds with a non-zero status, and rank 0, which would have
     written the image, leaves neither the image nor a temporary file behind. (The same run
     without the kill writes the image.)"""
     out = tmp_path / "frame.png"
-    done, seconds = launch("fail.py", 4, "2", "radix-k:2x2", "1", "kill", str(out),
-                           timeout=60)
+    done, seconds = launch("fail.py", 3, "2", "radix-k", "0", "kill", str(out), timeout=60)
     assert done.returncode != 0
     assert seconds < 30
     assert list(tmp_path.iterdir()) == []
-    done, _ = launch("fail.py", 4, "9", "radix-k:2x2", "1", "kill", str(out), timeout=60)
+    done, _ = launch("fail.py", 3, "9", "radix-k", "0", "kill", str(out), timeout=60)
     assert done.returncode == 0, done.stderr
     assert [p.name for p in tmp_path.iterdir()] == ["frame.png"]
 

@@ -9,7 +9,9 @@ from chapters.common import figure_path, read_json, result_path, save_figure
 STYLE = {"object slabs": ("C0", "o"), "object shafts": ("C1", "s"),
          "object blocks": ("C2", "^"), "object blocks interleaved": ("C2", "v"),
          "object blocks binary swap": ("C4", "D"), "binary swap full screen": ("C4", "x"),
-         "image static": ("C3", "P"), "image dynamic": ("C5", "*")}
+         "object blocks dynamic": ("C2", "P"), "image static": ("C3", "P"),
+         "image static interleaved": ("C3", "X"), "image dynamic": ("C5", "*"),
+         "image dynamic interleaved": ("C5", "h")}
 
 
 def series(rows, name, torus, key):

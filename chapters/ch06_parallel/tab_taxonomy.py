@@ -2,15 +2,20 @@
 exponents of the simulated classes."""
 
 
+from chapters.ch06_parallel.run_network import short_name
 from chapters.common import figure_path, read_json, result_path, write_csv
 from vrlib.parallel.taxonomy import TAXONOMY, communication
 
 
 def main():
-    write_csv(figure_path(__file__, "taxonomy.csv"), ["class", "what moves each frame",
-                                                      "how much"],
-              [[p.name, *communication(p)] for p in TAXONOMY])
     data = read_json(result_path(__file__, "network.json"))
+    counted = []
+    for p in TAXONOMY:
+        row = data["per_class"][short_name(p)]
+        counted.append([p.name, *communication(p), f"{row['total'] / 1e6:.2f} (P={row['nodes']})"])
+    write_csv(figure_path(__file__, "taxonomy.csv"), ["class", "what moves each frame",
+                                                      "how much", "simulated MB per frame"],
+              counted)
     rows = []
     at = 64
     for key, fits in data["exponents"].items():

@@ -1,61 +1,99 @@
-"""Figure: bytes each rank sent against the traffic model, and the imbalance of each load
-balance on dense and sparse scenes."""
+"""Figure: bytes each rank sent against the traffic model, load imbalance, memory per rank,
+frame times with the model beyond them, and compositing time and bytes against image size."""
 
 import matplotlib.pyplot as plt
 import numpy as np
 
 from chapters.common import figure_path, read_json, result_path, save_figure
-from vrlib.parallel.composite import COMPOSITORS
+
+OBJECT = ("direct-send", "binary-swap", "radix-k")
+COLOURS = {"direct-send": "C3", "binary-swap": "C0", "radix-k": "C1", "image": "C2",
+           "image-interleaved": "C4"}
 
 
 def main():
     data = read_json(result_path(__file__, "mpi.json"))
-    fig, (left, middle, right) = plt.subplots(1, 3, figsize=(15, 4.3))
-    series = [(name, name.replace("-", " ")) for name in COMPOSITORS]
-    series.append(("image", "image partition (voxels)"))
-    for (key, label), marker in zip(series, "os^Dv<>", strict=False):
+    ortho = data["settings"]["orbit"]
+    fig, axes = plt.subplots(2, 3, figsize=(13, 8))
+    ax = axes[0, 0]
+    for key in (*OBJECT, "image", "image-interleaved"):
         sim, meas = [], []
-        for e in data["equality"]:
-            case = next(c for c in e["cases"] if c["compositing"] == key
-                        and c["balance"] in ("even", None))
-            field = "voxels" if key == "image" else "composite"
+        for e in data["equality"][1:]:
+            case = next(c for c in e["cases"] if c["compositing"] == key and
+                        c["balance"] in ("even", None) and c["orbit"] == ortho)
+            field = "voxels" if key.startswith("image") else "composite"
             meas += [r["bytes"][field] for r in case["ranks"]]
             sim += e["simulated"][key]
-        left.loglog(np.array(sim) / 1e3, np.array(meas) / 1e3, marker, ms=5, alpha=0.7,
-                    label=label)
-    lims = left.get_xlim()
-    left.plot(lims, lims, color="0.5", lw=0.8, ls=":")
-    left.set_xlabel("traffic module, kB per rank")
-    left.set_ylabel("sent by the MPI renderer, kB per rank")
-    left.set_title("Bytes per rank, 2-8 ranks (float64 pixels and voxels)", fontsize=10)
-    left.legend(fontsize=8)
-    width = 0.25
+        ax.loglog(np.array(sim) / 1e3, np.array(meas) / 1e3, "o", ms=3, alpha=0.6,
+                  color=COLOURS[key], label=key.replace("-", " "))
+    lims = ax.get_xlim()
+    ax.plot(lims, lims, color="0.5", lw=0.8, ls=":")
+    ax.set_xlabel("traffic module, kB per rank")
+    ax.set_ylabel("sent by the MPI renderer, kB per rank")
+    ax.set_title("Bytes per rank, 2-12 ranks", fontsize=10)
+    ax.legend(fontsize=7)
+    ax = axes[0, 1]
     groups = [(b["scene"], b["ranks"]) for b in data["balance"]]
-    for i, balance in enumerate(("even", "interleaved", "work")):
-        values = []
-        for b in data["balance"]:
-            case = next(c for c in b["cases"] if c["balance"] == balance)
-            samples = np.array([r["samples"] for r in case["ranks"]], dtype=float)
-            values.append(samples.max() / samples.mean())
-        middle.bar(np.arange(len(groups)) + (i - 1) * width, values, width,
-                   label="work-sized k-d split (new)" if balance == "work" else balance)
-    middle.axhline(1.0, color="0.5", lw=0.8)
-    middle.set_xticks(range(len(groups)), [f"{s}\n{p} ranks" for s, p in groups])
-    middle.set_ylabel("max / mean ray samples per rank")
-    middle.set_title("Load imbalance (1 is perfect)", fontsize=10)
-    middle.legend(fontsize=8)
-    rows = data["prediction"]["rows"]
-    p = [r["ranks"] for r in rows]
-    right.loglog(p, [r["frame_s"] for r in rows], "-o", label="model frame time")
-    right.loglog(p, [r["composite_s"] for r in rows], "--", label="model compositing")
-    measured = [(t["ranks"], c["seconds"]) for t in data["timing"] for c in t["cases"]
-                if c["compositing"] == "binary-swap"]
-    right.loglog(*zip(*measured, strict=True), "kD", ms=7, label="measured (binary swap)")
-    right.set_xlabel("ranks")
-    right.set_ylabel("seconds per frame")
-    right.set_title("Measured on this machine, predicted beyond it", fontsize=10)
-    right.legend(fontsize=8)
-    for ax in (left, right):
+    keys = ("even", "interleaved", "work", "image", "image-interleaved")
+    width = 0.8 / len(keys)
+    for i, key in enumerate(keys):
+        values = [data["summary"]["imbalance"][f"{s} {p} {key}"] for s, p in groups]
+        label = {"work": "work-sized split (new)", "image": "image tiles",
+                 "image-interleaved": "image, interleaved tiles"}.get(key, f"{key} bricks")
+        ax.bar(np.arange(len(groups)) + (i - 2) * width, values, width, label=label)
+    ax.axhline(1.0, color="0.5", lw=0.8)
+    ax.set_xticks(range(len(groups)), [f"{s}\n{p} ranks" for s, p in groups])
+    ax.set_ylabel("max / mean ray samples per rank")
+    ax.set_title("Load imbalance (1 is perfect)", fontsize=10)
+    ax.legend(fontsize=7)
+    ax = axes[0, 2]
+    memory = data["memory"]
+    ranks = np.arange(memory["ranks"])
+    ax.bar(ranks, np.array(memory["peak"]) / 2**20, color="C1", label="peak during the frame")
+    ax.bar(ranks, np.array(memory["resident"]) / 2**20, color="0.6",
+           label="resident before it (libraries)")
+    ax.axhline(memory["volume_bytes"] / 2**20, color="k", ls="--",
+               label=f"the volume ({memory['samples']}$^3$ float32)")
+    ax.set_xlabel("rank")
+    ax.set_ylabel("MiB")
+    ax.set_title(f"Memory per rank, {memory['ranks']} ranks reading a .npy file", fontsize=10)
+    ax.legend(fontsize=7)
+    ax = axes[1, 0]
+    times = data["summary"]["times"]
+    for name in OBJECT:
+        measured = [(t["ranks"], times[f"{name} {t['ranks']}"]) for t in data["timing"]]
+        p = np.array([r for r, _ in measured])
+        med = np.array([m["median"] for _, m in measured])
+        err = np.array([[m["median"] - m["least"] for _, m in measured],
+                        [m["most"] - m["median"] for _, m in measured]])
+        ax.errorbar(p, med, yerr=err, fmt="D", color=COLOURS[name], ms=5,
+                    label=f"{name} measured")
+        rows = data["prediction"]["rows"][name]
+        ax.plot([r["ranks"] for r in rows], [r["frame_s"] for r in rows], "-",
+                color=COLOURS[name], lw=1, label=f"{name} model")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.axvspan(2.5, 8.5, color="0.9", zorder=0)
+    ax.set_xlabel("ranks (shaded: oversubscribed on 2 cores)")
+    ax.set_ylabel("seconds per frame")
+    ax.set_title("Frame time: medians (bars: least to most) and model", fontsize=10)
+    ax.legend(fontsize=7)
+    for ax, key, label in ((axes[1, 1], "seconds", "median ms per frame"),
+                           (axes[1, 2], "bytes", "most MB sent by a rank")):
+        for run, style in zip(data["compositing"], ("-o", "--s", ":^"), strict=False):
+            for name in OBJECT:
+                sel = [c for c in run["cases"] if c["compositing"] == name]
+                widths = [c["width"] for c in sel]
+                values = [c["seconds"] * 1e3 if key == "seconds" else max(c["bytes"]) / 1e6
+                          for c in sel]
+                ax.loglog(widths, values, style, color=COLOURS[name], ms=4,
+                          label=f"{name}, {run['ranks']} ranks")
+        ax.set_xlabel("image width (pixels)")
+        ax.set_ylabel(label)
+        ax.set_xticks([256, 512, 1024, 2048], ["256", "512", "1024", "2048"])
+        ax.set_title("Compositing alone against image size", fontsize=10)
+    axes[1, 1].legend(fontsize=6, ncol=2)
+    for ax in axes.ravel():
         ax.grid(True, which="both", alpha=0.3)
     fig.tight_layout()
     save_figure(fig, figure_path(__file__, "mpi.png"))

@@ -1,36 +1,63 @@
-"""Tables: equality and bytes per rank count; timings, speedup and efficiency."""
+"""Tables: equality and bytes per rank count; frame timings with the model's prediction; and
+compositing time against image size."""
 
 import numpy as np
 
 from chapters.common import figure_path, read_json, result_path, write_csv
 
+OBJECT = ("direct-send", "binary-swap", "radix-k")
+IMAGE = ("image", "image-interleaved")
+
 
 def main():
     data = read_json(result_path(__file__, "mpi.json"))
+    ortho = data["settings"]["orbit"]
     rows = []
     for e in data["equality"]:
-        for case in e["cases"]:
-            field = "voxels" if case["compositing"] == "image" else "composite"
-            sent = np.array([r["bytes"][field] for r in case["ranks"]], dtype=float)
-            rows.append([e["ranks"], case["compositing"], case["balance"] or "",
-                         f"{case['difference']:.1e}", f"{sent.mean() / 1e3:.1f}",
-                         f"{sent.max() / 1e3:.1f}"])
+        worst = max(c["difference"] for c in e["cases"])
+        kb = []
+        for key in OBJECT + IMAGE:
+            case = next(c for c in e["cases"] if c["compositing"] == key and
+                        c["balance"] in ("even", None) and c["orbit"] == ortho)
+            field = "voxels" if key in IMAGE else "composite"
+            kb.append(np.mean([r["bytes"][field] for r in case["ranks"]]) / 1e3)
+        rows.append([e["ranks"], len(e["cases"]), f"{worst:.1e}",
+                     *(f"{v:.1f}" for v in kb)])
     write_csv(figure_path(__file__, "equality.csv"),
-              ["ranks", "partition / compositing", "balance", "max difference from serial",
-               "mean kB sent per rank", "max kB sent per rank"], rows)
-    one = {c["compositing"]: c["seconds"] for c in data["timing"][0]["cases"]}
+              ["ranks", "images compared", "max difference from serial",
+               *(f"{k} kB/rank" for k in OBJECT), "image kB/rank",
+               "image interleaved kB/rank"], rows)
+    times = data["summary"]["times"]
     rows = []
     for t in data["timing"]:
         for case in t["cases"]:
-            speedup = one[case["compositing"]] / case["seconds"]
-            rows.append([t["ranks"], case["compositing"], f"{case['seconds']:.3f}",
-                         f"{speedup:.2f}", f"{speedup / t['ranks']:.2f}"])
-    for r in data["prediction"]["rows"]:
-        if r["ranks"] > 2:
-            rows.append([r["ranks"], "binary-swap (model)", f"{r['frame_s']:.4f}",
-                         f"{r['speedup']:.1f}", f"{r['speedup'] / r['ranks']:.2f}"])
+            name, ranks = case["compositing"], t["ranks"]
+            one = times[f"{name} 1"]["median"]
+            spread = times[f"{name} {ranks}"]
+            rows.append([ranks, name, f"{case['seconds']:.3f}",
+                         f"{spread['least']:.3f}-{spread['most']:.3f}",
+                         f"{one / case['seconds']:.2f}",
+                         f"{one / case['seconds'] / ranks:.2f}",
+                         "" if ranks <= 2 else "oversubscribed"])
+    for name, model in data["prediction"]["rows"].items():
+        for r in model:
+            if r["ranks"] > 8:
+                rows.append([r["ranks"], f"{name} (model)", f"{r['frame_s']:.4f}", "",
+                             f"{r['speedup']:.1f}", f"{r['speedup'] / r['ranks']:.2f}",
+                             f"{r['rounds']} rounds"])
     write_csv(figure_path(__file__, "timing.csv"),
-              ["ranks", "compositing", "seconds per frame", "speedup", "efficiency"], rows)
+              ["ranks", "compositing", "median seconds per frame", "least-most",
+               "speedup", "efficiency", "note"], rows)
+    rows = []
+    for run in data["compositing"]:
+        for case in run["cases"]:
+            rows.append([run["ranks"], case["width"], case["compositing"],
+                         f"{case['seconds'] * 1e3:.1f}",
+                         f"{case['least'] * 1e3:.1f}-{case['most'] * 1e3:.1f}",
+                         f"{max(case['bytes']) / 1e6:.2f}"])
+    write_csv(figure_path(__file__, "compositing.csv"),
+              ["ranks", "image width", "compositing", "median ms", "least-most ms",
+               "most MB sent by a rank"], rows)
 
 
 if __name__ == "__main__":

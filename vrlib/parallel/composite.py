@@ -110,6 +110,22 @@ def _composite_in_order(region, pieces):
     return out
 
 
+def _merge_in_order(target, region, mine, pieces):
+    """Composite received ``pieces`` ``[(key, rect, pixels), ...]`` into ``target``, the
+    pixels of ``region`` this rank holds (visibility key ``mine``), in place: the pieces
+    behind it under it, nearest first, and the pieces in front of it over it, nearest first,
+    one over operation per piece on its own rectangle."""
+    behind = sorted((p for p in pieces if p[0] > mine), key=lambda p: p[0])
+    front = sorted((p for p in pieces if p[0] < mine), key=lambda p: -p[0])
+    for pieces_, mine_in_front in ((behind, True), (front, False)):
+        for _key, rect, buf in pieces_:
+            if buf is None:
+                continue
+            part = target[rect[0] - region[0]:rect[1] - region[0],
+                          rect[2] - region[2]:rect[3] - region[2]]
+            part[...] = over(part, buf) if mine_in_front else over(buf, part)
+
+
 def _own(rgba, rect):
     """This rank's own pixels of ``rect``, as a piece (None when it drew nothing there)."""
     drawn = content(rgba, rect)
@@ -138,14 +154,20 @@ class DirectSend(Compositor):
             for dest in range(size):
                 if dest != rank:
                     sends.append((dest, clip(drawn, tiles.rects(dest)[0]), rgba))
-            pieces.append((position[brick.index], *_own(rgba, mine)))
+            if len(held) > 1:
+                pieces.append((position[brick.index], *_own(rgba, mine)))
         # Each source sends its bricks in index order.
         sources = [(int(owners[b]), b) for b in range(len(tree)) if owners[b] != rank]
         sources.sort()
         received = exchange.swap(0, sends, [s for s, _ in sources])
-        pieces += [(position[b], rect, buf) for (_, b), (rect, buf) in zip(sources, received,
-                                                                             strict=True)]
-        return mine, _composite_in_order(mine, pieces)
+        received = [(position[b], rect, buf) for (_, b), (rect, buf) in zip(sources, received,
+                                                                              strict=True)]
+        if len(held) == 1:  # composite into this rank's own image, in place
+            brick, rgba = held[0]
+            target = rgba[mine[0]:mine[1], mine[2]:mine[3]]
+            _merge_in_order(target, mine, position[brick.index], received)
+            return mine, np.ascontiguousarray(target)
+        return mine, _composite_in_order(mine, pieces + received)
 
     def rounds(self, tree, owners, tiles, view, origin, spacing, *, bytes_per_pixel=4):
         return [direct_send_messages(tree, owners, tiles, view, origin, spacing,
@@ -497,11 +519,9 @@ class RadixK(Compositor):
                 round, [(m, content(rgba, pieces[j]), rgba) for j, m in enumerate(members)
                         if j != digit], others)
             region = pieces[digit]
-            parts = [(key(rank), *_own(rgba, region))]
-            parts += [(key(m), rect, buf) for m, (rect, buf) in zip(others, received,
-                                                                     strict=True)]
-            rgba[region[0]:region[1], region[2]:region[3]] = _composite_in_order(region,
-                                                                                 parts)
+            _merge_in_order(rgba[region[0]:region[1], region[2]:region[3]], region, key(rank),
+                            [(key(m), rect, buf) for m, (rect, buf) in zip(others, received,
+                                                                            strict=True)])
             stride *= k
         return region, np.ascontiguousarray(rgba[region[0]:region[1], region[2]:region[3]])
 

@@ -13,6 +13,7 @@ float64, as :class:`vrlib.Volume` stores them, so a brick holds no more than its
 from __future__ import annotations
 
 import math
+import mmap
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -175,7 +176,7 @@ def open_source(source, shape, extent):
         storage = np.float64 if scaling is not None else storage_dtype(array.dtype)
 
         def read(region):
-            block = np.array(array[tuple(slice(a, b) for a, b in region)], dtype=storage)
+            block = _read_mapped(array, region, storage)
             if scaling is not None:
                 block = block * scaling[0] + scaling[1]
             if not np.all(np.isfinite(block)):
@@ -197,6 +198,28 @@ def open_source(source, shape, extent):
     origin = ext[:, 0].copy()
     spacing = (ext[:, 1] - ext[:, 0]) / (np.array(shape[::-1]) - 1)
     return Lattice(tuple(shape), origin, spacing), read
+
+
+#: Bytes of a file read between releases of its mapped pages.
+SLAB_BYTES = 64 << 20
+
+
+def _read_mapped(array, region, storage):
+    """Samples ``region`` of a memory-mapped ``array`` as ``storage``, a slab of z-planes at a
+    time. Pages of a mapped file count in the process's resident memory once touched, and
+    the pages under a brick's rows span much more of the file than the brick (whole rows,
+    and the kernel maps the pages around each one it faults in), so each slab's pages are
+    released before the next is read: a rank holds its brick and one slab, not the file."""
+    (z0, z1), ys, xs = region
+    out = np.empty([b - a for a, b in region], dtype=storage)
+    plane = math.prod(array.shape[1:]) * array.dtype.itemsize
+    step = max(1, SLAB_BYTES // plane)
+    mapping = getattr(array, "_mmap", None)
+    for z in range(z0, z1, step):
+        out[z - z0:min(z + step, z1) - z0] = array[z:min(z + step, z1), slice(*ys), slice(*xs)]
+        if mapping is not None and hasattr(mmap, "MADV_DONTNEED"):
+            mapping.madvise(mmap.MADV_DONTNEED)
+    return out
 
 
 def ghost(filt):
