@@ -127,7 +127,7 @@ def test_every_compositor_has_both_faces(name):
     registry name."""
     compositor = COMPOSITORS[name]
     assert isinstance(compositor, Compositor) and compositor.name == name
-    for face in ("composite", "messages"):
+    for face in ("composite", "rounds"):
         assert getattr(type(compositor), face) is not getattr(Compositor, face), face
 
 

@@ -183,6 +183,76 @@ def test_classic_binary_swap_sends_w2_one_minus_one_over_p():
         assert bounded < msgs.total
 
 
+@pytest.mark.parametrize("parts", [2, 4, 8, 16, 64])
+def test_radix_k_with_k_two_is_binary_swap(parts):
+    """Radix-k with k = 2 in every round cuts the same k-d tree and sends exactly binary
+    swap's messages, round by round."""
+    origin, spacing = lattice(33)
+    view = View.orbit(azimuth=30, elevation=20, size=64)
+    radix = composite.RadixK(target=2)
+    tree = radix.split((32, 32, 32), parts)
+    assert tree == decompose.split((32, 32, 32), parts)
+    swap = composite.binary_swap_rounds(tree, view, origin, spacing)[1:]  # no fold
+    for a, b in zip(radix.rounds(tree, np.arange(parts), None, view, origin, spacing), swap,
+                    strict=True):
+        assert (a.src.tolist(), a.dst.tolist(), a.bytes.tolist()) == \
+            (b.src.tolist(), b.dst.tolist(), b.bytes.tolist())
+
+
+@pytest.mark.parametrize("parts", [1, 2, 3, 6, 7, 12, 30, 64, 96, 4096])
+@pytest.mark.parametrize("target", [2, 3, 8, 64])
+def test_radix_factors_multiply_to_the_count(parts, target):
+    """The default factorisation multiplies to the rank count, each factor at most the target
+    unless a prime exceeds it, and no two neighbouring factors could be merged."""
+    factors = composite.radix_factors(parts, target)
+    assert math.prod(factors) == parts
+    for f in factors:
+        assert f <= target or all(f % p for p in range(2, math.isqrt(f) + 1))
+
+
+@pytest.mark.parametrize("groups", [[2, 3], [3, 2], [2, 2, 3], [5], [3, 4]])
+def test_grouped_split_makes_every_group_a_subtree(groups):
+    """Every block of k_1, k_1 k_2, ... consecutive bricks is one subtree of the k-d tree, so
+    that radix-k's groups are contiguous in every visibility order."""
+    parts = math.prod(groups)
+    tree = decompose.split((24, 24, 24), parts, groups=groups)
+    subtrees = set()
+
+    def visit(node):
+        leaves = tuple(tree.leaves(node))
+        subtrees.add(leaves)
+        if isinstance(node, tuple):
+            visit(node[2])
+            visit(node[3])
+
+    visit(tree.node)
+    size = 1
+    for k in groups:
+        size *= k
+        for start in range(0, parts, size):
+            assert tuple(range(start, start + size)) in subtrees
+    for view in (View.orbit(azimuth=a, elevation=e, size=8) for a, e in [(30, 20), (-100, 60)]):
+        order = tree.order(view, *lattice(25))
+        for block in (b for b in subtrees if len(b) > 1):
+            where = sorted(order.index(i) for i in block)
+            assert where == list(range(where[0], where[0] + len(block)))
+
+
+def test_radix_k_sends_the_classic_count_with_full_regions():
+    """Sending whole pieces, each node sends (1 - 1/P) of the image over radix-k's rounds,
+    whatever the factorisation (as binary swap does); bounded rectangles send less."""
+    origin, spacing = lattice(33)
+    view = View.orbit(azimuth=30, elevation=20, size=60)
+    for factors in ([2, 3], [6], [3, 2, 2], [4, 3]):
+        parts = math.prod(factors)
+        tree = decompose.split((32, 32, 32), parts, groups=factors)
+        full = composite.radix_k_messages(tree, view, origin, spacing, factors,
+                                          bytes_per_pixel=1, bounded=False)
+        np.testing.assert_allclose(full.sent_per_node(parts), 60 * 60 * (1 - 1 / parts))
+        assert composite.radix_k_messages(tree, view, origin, spacing, factors).total < \
+            4 * full.total
+
+
 def test_direct_send_matches_the_bounding_rectangle_model():
     """Simulated direct-send bytes against the model's bounding rectangles for the same view,
     within 5%: pixel rounding at rectangle edges, and the model keeps ``1/P`` of each local

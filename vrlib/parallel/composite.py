@@ -525,11 +525,12 @@ class RadixK(Compositor):
             stride *= k
         return region, np.ascontiguousarray(rgba[region[0]:region[1], region[2]:region[3]])
 
-    def rounds(self, tree, owners, tiles, view, origin, spacing, *, bytes_per_pixel=4):
+    def rounds(self, tree, owners, tiles, view, origin, spacing, *, bytes_per_pixel=4,
+               bounded=True):
         if not np.array_equal(owners, np.arange(len(tree))):
             raise ValueError("radix-k takes brick i on node i (owners 0, 1, ...)")
         return radix_k_rounds(tree, view, origin, spacing, self.factors_for(len(tree)),
-                              bytes_per_pixel=bytes_per_pixel)
+                              bytes_per_pixel=bytes_per_pixel, bounded=bounded)
 
     def __repr__(self):
         if self.factors is None and self.target == 8:
@@ -537,11 +538,12 @@ class RadixK(Compositor):
         return f"RadixK({list(self.factors) if self.factors else None}, target={self.target})"
 
 
-def radix_k_rounds(tree, view, origin, spacing, factors, *, bytes_per_pixel=4):
+def radix_k_rounds(tree, view, origin, spacing, factors, *, bytes_per_pixel=4, bounded=True):
     """Radix-k (Peterka et al. 2009) on the k-d tree's bricks, brick ``i`` on node ``i``: the
     messages of each round. Node ``s`` sends each member of its group the part of that
     member's piece inside the bounding rectangle of what its own group has merged so far
-    (vectorised over the nodes, so thousands of nodes and large ``k`` route in a moment).
+    (vectorised over the nodes, so thousands of nodes and large ``k`` route in a moment);
+    without ``bounded`` the whole piece (the classic count, ``W^2 (1 - 1/P)`` per node).
 
     Examples
     --------
@@ -560,9 +562,10 @@ def radix_k_rounds(tree, view, origin, spacing, factors, *, bytes_per_pixel=4):
         raise ValueError(f"radix-k factors {tuple(factors)} multiply to {math.prod(factors)}, "
                          f"not the {nodes} nodes")
     empty = np.array([np.inf, -np.inf, np.inf, -np.inf])
+    full = (0, view.height, 0, view.width)
     held = np.array([empty if is_empty(r) else r for r in
-                     (footprint_rect(view, *b.world_box(origin, spacing)) for b in tree.bricks)],
-                    dtype=float).reshape(nodes, 4)
+                     (footprint_rect(view, *b.world_box(origin, spacing)) if bounded else full
+                      for b in tree.bricks)], dtype=float).reshape(nodes, 4)
     region = np.tile(np.array([0, view.height, 0, view.width], dtype=np.int64), (nodes, 1))
     node = np.arange(nodes)
     out, stride = [], 1
@@ -601,10 +604,12 @@ def radix_k_rounds(tree, view, origin, spacing, factors, *, bytes_per_pixel=4):
     return out
 
 
-def radix_k_messages(tree, view, origin, spacing, factors, *, bytes_per_pixel=4):
+def radix_k_messages(tree, view, origin, spacing, factors, *, bytes_per_pixel=4,
+                     bounded=True):
     """All of radix-k's messages (:func:`radix_k_rounds` summed)."""
     return sum_messages(radix_k_rounds(tree, view, origin, spacing, factors,
-                                       bytes_per_pixel=bytes_per_pixel), len(tree))
+                                       bytes_per_pixel=bytes_per_pixel, bounded=bounded),
+                        len(tree))
 
 
 #: Compositors by name.
