@@ -221,7 +221,7 @@ class BinarySwap(Compositor):
     def composite(self, exchange, held, tree, owners, order, view):
         rank = exchange.rank
         rgba = held[0][1]
-        height, width = rgba.shape[:2]
+        full = (0, rgba.shape[0], 0, rgba.shape[1])
         position = {brick: i for i, brick in enumerate(order)}
         slots = swap_slots(tree)
         leaders = []
@@ -235,10 +235,10 @@ class BinarySwap(Compositor):
                 return NOTHING, None
             if rank == first:
                 ((rect, buf),) = exchange.swap(0, [], [second])
-                _merge(rgba, rect, buf, position[first] < position[second])
+                _merge_in_order(rgba, full, position[first], [(position[second], rect, buf)])
             leaders.append(first)
         s = leaders.index(rank)
-        region = (0, height, 0, width)
+        region = full
         for r in range(int(math.log2(len(slots)))):
             partner_slot = s ^ (1 << r)
             partner = leaders[partner_slot]
@@ -247,9 +247,10 @@ class BinarySwap(Compositor):
                                            [partner])
             # The group whose bricks come first in the visibility order is in front.
             group = 1 << (r + 1)
-            mine_front = min(position[b] for b in _group(tree, slots, s, group)) < \
-                min(position[b] for b in _group(tree, slots, partner_slot, group))
-            _merge(rgba, rect, buf, mine_front)
+            _merge_in_order(rgba, full,
+                            min(position[b] for b in _group(tree, slots, s, group)),
+                            [(min(position[b] for b in _group(tree, slots, partner_slot,
+                                                              group)), rect, buf)])
             region = keep
         return region, np.ascontiguousarray(rgba[region[0]:region[1], region[2]:region[3]])
 
@@ -259,14 +260,6 @@ class BinarySwap(Compositor):
             raise ValueError("binary swap takes brick i on node i (owners 0, 1, ...)")
         return binary_swap_rounds(tree, view, origin, spacing,
                                   bytes_per_pixel=bytes_per_pixel, bounded=bounded)
-
-
-def _merge(rgba, rect, buf, mine_in_front):
-    """Composite received pixels into ``rgba`` at ``rect``."""
-    if buf is None:
-        return
-    region = rgba[rect[0]:rect[1], rect[2]:rect[3]]
-    region[...] = over(region, buf) if mine_in_front else over(buf, region)
 
 
 def _group(tree, slots, slot, size):
