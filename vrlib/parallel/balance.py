@@ -59,12 +59,13 @@ def visible_cells(data, first, lo, hi, shape, *, filter="trilinear", transfer=No
     return work
 
 
-def work_split(block_work, cells, parts, *, groups=None):
+def work_split(block_work, cells, parts, *, splitter=split):
     """The work-sized k-d split: ``parts`` bricks of ``cells`` (z, y, x), each side of every
     cut holding visible volume (``block_work``, per block) in proportion to its bricks. A
     small floor (1% of the densest block's per-cell weight) keeps empty regions from being
-    free, since rays still cross them. ``groups`` as :func:`vrlib.parallel.decompose.split`
-    (radix-k's subtrees).
+    free, since rays still cross them. ``splitter(cells, parts, weights=...)`` cuts the tree:
+    :func:`vrlib.parallel.decompose.split`, or a compositor's own
+    (:meth:`vrlib.parallel.composite.Compositor.split`, radix-k's groups).
 
     Examples
     --------
@@ -76,7 +77,7 @@ def work_split(block_work, cells, parts, *, groups=None):
     weights = per_cell.repeat(BLOCK, 0).repeat(BLOCK, 1).repeat(BLOCK, 2)
     weights = weights[: cells[0], : cells[1], : cells[2]]
     weights = weights + 0.01 * max(float(weights.max()), 1e-300)
-    return split(cells, parts, weights=weights, groups=groups)
+    return splitter(cells, parts, weights=weights)
 
 
 def visible_work(comm, lattice, read, tree, filt, transfer, sent):

@@ -54,8 +54,8 @@ class Frame:
     ``ranks`` (root only) one dict per rank: bricks, samples, seconds rendering and
     compositing, bytes sent per phase (``balance``, ``voxels``, ``composite``,
     ``gather``), the process's peak resident memory (``peak_rss``, bytes), and (object
-    partition) ``messages``, one ``[round, destination, pixels]``
-    per rectangle the rank sent while compositing.
+    partition) ``messages``, one ``[round, destination, pixels]`` per rectangle the rank sent
+    while compositing.
 
     Examples
     --------
@@ -195,7 +195,6 @@ def render_object(comm, source, view, *, shape=None, extent=None, filter="trilin
             tree = split(lattice.cells, size * bricks_per_rank)
         else:
             tree = compositor.split(lattice.cells, size)
-        groups = compositor.factors_for(size) if isinstance(compositor, RadixK) else None
         owners = interleaved_owners(len(tree), size)
     ds = step * float(lattice.spacing.min())
     with Stage(comm, "reading its bricks"):
@@ -209,7 +208,7 @@ def render_object(comm, source, view, *, shape=None, extent=None, filter="trilin
     if balance == "work":
         with Stage(comm, "measuring its visible volume"):
             block_work = visible_work(comm, lattice, read, tree, filt, transfer, sent)
-        tree = work_split(block_work, lattice.cells, size, groups=groups)
+        tree = work_split(block_work, lattice.cells, size, splitter=compositor.split)
         with Stage(comm, "reading its re-balanced brick"):
             brick = tree.bricks[rank]
             region = brick.samples(ghost(filt), lattice.shape)
