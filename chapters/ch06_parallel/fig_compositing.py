@@ -4,6 +4,7 @@ per node count."""
 
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.ticker import NullFormatter
 
 from chapters.common import figure_path, read_json, result_path, save_figure, write_csv
 from vrlib.parallel.composite import radix_factors
@@ -56,6 +57,9 @@ def main():
     ax.set_title("Bytes: bounding rectangles of what each node holds", fontsize=9)
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=8)
+    for ax in axes:
+        ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.yaxis.set_minor_formatter(NullFormatter())
     fig.tight_layout()
     save_figure(fig, figure_path(__file__, "compositing.png"))
     table = []

@@ -3,6 +3,7 @@ frame times with the model beyond them, and compositing time and bytes against i
 
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.ticker import NullFormatter
 
 from chapters.common import figure_path, read_json, result_path, save_figure
 
@@ -95,6 +96,8 @@ def main():
     axes[1, 1].legend(fontsize=6, ncol=2)
     for ax in axes.ravel():
         ax.grid(True, which="both", alpha=0.3)
+        ax.xaxis.set_minor_formatter(NullFormatter())
+        ax.yaxis.set_minor_formatter(NullFormatter())
     fig.tight_layout()
     save_figure(fig, figure_path(__file__, "mpi.png"))
 

@@ -173,7 +173,8 @@ def median_case(run, name):
 
 
 def fit_round_cost(compositing):
-    """Cost of one compositing round at 2 ranks (one core each): ``seconds = a + b x bytes``
+    """Cost of one compositing round at 2 ranks (one core each, one message each):
+    ``seconds = a + b x bytes``
     fitted over image sizes and compositors (least squares), the bytes being the most any
     rank sent."""
     two = next(c for c in compositing if c["ranks"] == 2)["cases"]
@@ -185,9 +186,10 @@ def fit_round_cost(compositing):
 
 def predict(timing, compositing):
     """Frame time at larger P from the measured costs: the 1-rank frame (sampling, ray casting,
-    everything but communication) divided evenly over P ranks, plus each compositor's rounds,
-    each costing the fitted ``a + b x bytes`` of the busiest sender in that round (the
-    traffic module's rounds for the same view). The model assumes one core per rank, the
+    everything but communication) divided evenly over P ranks, plus each compositor's rounds
+    (the traffic module's, for the same view), each costing the fitted ``a`` per message the
+    busiest sender posts plus ``b`` per byte the busiest sender sends (at two ranks a round
+    is one message, so ``a`` is a message's cost). The model assumes one core per rank, the
     measured per-round cost at any P, and no network contention."""
     a, b = fit_round_cost(compositing)
     n, size = TIMING["n"], TIMING["size"]
@@ -204,7 +206,8 @@ def predict(timing, compositing):
             rounds = [m for m in compositor.rounds(tree, np.arange(p), tiles, view, origin,
                                                    spacing, bytes_per_pixel=PIXEL_BYTES)
                       if m.bytes.size]
-            composite_s = sum(a + b * float(m.sent_per_node(p).max()) for m in rounds)
+            composite_s = sum(a * int(np.bincount(m.src, minlength=p).max()) +
+                              b * float(m.sent_per_node(p).max()) for m in rounds)
             work = single / p
             rows.append({"ranks": p, "work_s": work, "composite_s": composite_s,
                          "rounds": len(rounds), "frame_s": work + composite_s,

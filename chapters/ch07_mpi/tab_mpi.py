@@ -48,6 +48,25 @@ def main():
     write_csv(figure_path(__file__, "timing.csv"),
               ["ranks", "compositing", "median seconds per frame", "least-most",
                "speedup", "efficiency", "note"], rows)
+    summary = data["summary"]
+    write_csv(figure_path(__file__, "sent.csv"),
+              ["compositing", "sent / simulated, least", "most"],
+              [[k, f"{v[0]:.2f}", f"{v[1]:.2f}"]
+               for k, v in summary["sent_over_simulated"].items()])
+    keys = ("even", "interleaved", "work", "image", "image-interleaved")
+    rows = []
+    for b in data["balance"]:
+        group = f"{b['scene']} {b['ranks']}"
+        rows.append([f"{b['scene']}, {b['ranks']}",
+                     *(f"{summary['imbalance'][f'{group} {k}']:.2f}" for k in keys)])
+    write_csv(figure_path(__file__, "balance.csv"),
+              ["scene, ranks", "equal bricks", "interleaved bricks (4 per rank)",
+               "work-sized split", "image tiles", "image, interleaved tiles"], rows)
+    write_csv(figure_path(__file__, "radix_vs_swap.csv"),
+              ["ranks", "image width", "time, radix-k / binary swap",
+               "most bytes sent by a rank, radix-k / binary swap"],
+              [[*key.split(" "), f"{r['time']:.2f}", f"{r['bytes']:.2f}"]
+               for key, r in summary["radix_vs_swap"].items()])
     rows = []
     for run in data["compositing"]:
         for case in run["cases"]:
