@@ -76,6 +76,7 @@ def test_every_image_is_finite_and_in_range(data, method, filt, step):
                        transfer=glow_for(volume, kind)))
 
 
+@pytest.mark.slow  # tests/test_skipping.py checks the same in make test, case by case
 @RENDERS
 @given(data=st.data(), method=st.sampled_from(["raycast", "shearwarp"]),
        filt=st.sampled_from(FILTERS), threshold=st.floats(0.1, 0.9))

@@ -204,12 +204,10 @@ def test_sheet_and_direct_agree_under_glow():
         np.testing.assert_allclose(slabs.rgba, direct.rgba, atol=1e-4)
 
 
-@pytest.mark.slow
 def test_sheet_and_direct_differ_for_a_sharp_transfer_function():
     """Classifying each voxel before reconstruction (direct) blurs a sharp transfer function:
     the images differ, and sheet buffers are closer to the ray caster, which classifies the
-    reconstructed field. (In ``make test-all``: it alone compiles the sheet kernel for a
-    lookup table, 20 s of ``make test``'s budget.)"""
+    reconstructed field."""
     field = data_gen.make_field("smooth-sphere", radius=0.6, width=0.15)
     vol = field.sample(32)
     step_tf = LookupTransfer(np.r_[np.zeros(50), np.full(51, 8.0)], value_range=(0, 1))

@@ -102,7 +102,8 @@ def _image_errors(field, n, scale, methods, size=48, filters=("catmull-rom", "py
 
 
 @pytest.mark.claim(1, "supports")
-@pytest.mark.parametrize("method", ["raycast", "shear3", "shear2", "shearwarp"])
+@pytest.mark.parametrize("method", ["raycast", pytest.param("shear3", marks=pytest.mark.slow),
+                                    "shear2", "shearwarp"])
 def test_catmull_rom_images_are_closest_to_the_reference(method):
     """Image part of claim 1 (chapter ch03): on Marschner-Lobb at 41^3 and on a blob of about
     1.2 samples at 24^3, the Catmull-Rom image has a lower rmse than the pyramid's, the

@@ -77,9 +77,13 @@ class Compositor:
         return split(cells, ranks, weights=weights)
 
     def composite(self, exchange, held, tree, owners, order, view):
+        """Composite this rank's local images with the others' over MPI (the rounds of
+        ``exchange``); returns this rank's finished screen rectangle and its pixels."""
         raise NotImplementedError
 
     def rounds(self, tree, owners, tiles, view, origin, spacing, *, bytes_per_pixel=4):
+        """The same frame's messages, one :class:`~vrlib.parallel.traffic.Messages` per
+        round, sized from the bricks' projected footprints."""
         raise NotImplementedError
 
     def messages(self, tree, owners, tiles, view, origin, spacing, *, bytes_per_pixel=4,

@@ -55,7 +55,7 @@ class RawFile:
     >>> import tempfile, pathlib
     >>> f = pathlib.Path(tempfile.mkdtemp()) / "v.raw"
     >>> np.arange(27, dtype=np.uint8).tofile(f)
-    >>> array, extent = memory_map(RawFile(f, (3, 3, 3), "uint8"))
+    >>> array, extent, scaling = memory_map(RawFile(f, (3, 3, 3), "uint8"))
     >>> int(array[2, 1, 0]), extent.tolist()[0]
     (21, [-1.0, 1.0])
     """
