@@ -9,6 +9,7 @@ examples per property; ``make test-all`` (HYPOTHESIS_PROFILE=thorough) many more
 import os
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
