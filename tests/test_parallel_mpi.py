@@ -125,9 +125,7 @@ def test_every_message_is_bounded_by_the_simulated_one():
     vol = data_gen.make_field("marschner-lobb").sample(n)
     tiles = decompose.screen_tiles(size, size, ranks)
     for r in results:
-        name, _, factors = r["compositing"].partition(":")
-        compositor = mpi.RadixK([int(f) for f in factors.split("x")]) if factors else \
-            composite.COMPOSITORS[name]
+        compositor = composite.compositor(r["compositing"])
         tree = compositor.split((n - 1,) * 3, ranks)
         rounds = compositor.rounds(tree, np.arange(ranks), tiles, view, vol.origin,
                                    vol.spacing, bytes_per_pixel=1)

@@ -20,6 +20,7 @@ from chapters.common import by_profile, progress, result_path, write_json
 from vrlib import View
 from vrlib.parallel import network
 from vrlib.parallel.composite import COMPOSITORS, RadixK, radix_factors
+from vrlib.parallel.decompose import screen_tiles
 
 NODES = by_profile([4, 6, 8, 12, 16, 24, 32, 48, 64, 96, 128, 256, 384, 512, 1024, 2048, 4096],
                    [4, 6, 8, 12, 16, 24, 32, 48, 64, 96, 128, 256, 384, 512, 1024, 2048, 4096])
@@ -49,8 +50,8 @@ def simulate(compositor, nodes, view, nets):
     """Counts and the modelled time of one frame on each network."""
     origin, spacing = np.array([-1.0, -1.0, -1.0]), np.full(3, 2.0 / (SAMPLES - 1))
     tree = compositor.split((SAMPLES - 1,) * 3, nodes)
-    rounds = compositor.rounds(tree, np.arange(nodes), None if compositor.name != "direct-send"
-                               else _tiles(nodes), view, origin, spacing,
+    tiles = screen_tiles(WIDTH, WIDTH, nodes) if compositor.name == "direct-send" else None
+    rounds = compositor.rounds(tree, np.arange(nodes), tiles, view, origin, spacing,
                                bytes_per_pixel=PIXEL_BYTES)
     rounds = [m for m in rounds if m.bytes.size]
     sent = sum(m.sent_per_node(nodes) for m in rounds) if rounds else np.zeros(nodes)
@@ -69,12 +70,6 @@ def simulate(compositor, nodes, view, nets):
             busiest += load.max
         row[kind] = {"seconds": seconds, "busiest": busiest}
     return row
-
-
-def _tiles(nodes):
-    from vrlib.parallel.decompose import screen_tiles
-
-    return screen_tiles(WIDTH, WIDTH, nodes)
 
 
 def main():

@@ -16,9 +16,8 @@ import time
 import numpy as np
 from mpi4py import MPI
 
-from chapters.ch07_mpi._frame import compositor
 from vrlib import View
-from vrlib.parallel.composite import COMPOSITORS
+from vrlib.parallel.composite import compositor
 from vrlib.parallel.exchange import Exchange
 from vrlib.parallel.traffic import footprint_rect
 
@@ -32,7 +31,6 @@ def main(comm, config):
         view = View.orbit(size=width, **config["orbit"])
         for spec in config["compositors"]:
             comp = compositor(spec)
-            comp = COMPOSITORS[comp] if isinstance(comp, str) else comp
             tree = comp.split((n - 1,) * 3, size)
             order = tree.order(view, origin, spacing)
             brick = tree.bricks[rank]

@@ -47,19 +47,13 @@ def ramp(threshold, scale):
     return vrlib.LookupTransfer(scale * np.clip((values - threshold) / (1 - threshold), 0, 1))
 
 
-def compositor(spec):
-    """A compositor name, or ``radix-k:AxB...`` for radix-k with those factors."""
-    name, _, factors = spec.partition(":")
-    return mpi.RadixK([int(f) for f in factors.split("x")]) if factors else name
-
-
 def render(comm, source, shape, view, transfer, compositing, balance):
     if compositing.startswith("image"):
         layout = "interleaved" if compositing == "image-interleaved" else "contiguous"
         return mpi.render_image(comm, source, view, shape=shape, transfer=transfer,
                                 layout=layout)
     return mpi.render_object(comm, source, view, shape=shape, transfer=transfer,
-                             compositing=compositor(compositing), balance=balance)
+                             compositing=compositing, balance=balance)
 
 
 def main(comm, config):

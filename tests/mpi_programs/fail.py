@@ -54,13 +54,6 @@ def inject(failing_round, when):
     exchange.Exchange.swap = failing_swap
 
 
-def compositor(spec):
-    name, _, factors = spec.partition(":")
-    if factors:
-        return mpi.RadixK([int(f) for f in factors.split("x")])
-    return name
-
-
 def main(comm, failing_rank, spec=None, failing_round=0, when="before", output=None):
     failing = failing_rank == comm.Get_rank()
     if spec is not None and failing:
@@ -69,7 +62,7 @@ def main(comm, failing_rank, spec=None, failing_round=0, when="before", output=N
     source = Flaky(failing and spec is None)
     try:
         frame = mpi.render_object(comm, source, view, shape=17,
-                                  compositing=compositor(spec or "binary-swap"))
+                                  compositing=spec or "binary-swap")
     except Exception as error:  # report it, then end this rank with an error status
         print(json.dumps({"rank": comm.Get_rank(), "error": type(error).__name__,
                           "message": str(error)}), flush=True)

@@ -24,12 +24,6 @@ import vrlib
 from vrlib.parallel import mpi
 
 
-def compositor(spec):
-    """A compositor name, or ``radix-k:AxB...`` for radix-k with those factors."""
-    name, _, factors = spec.partition(":")
-    return mpi.RadixK([int(f) for f in factors.split("x")]) if factors else name
-
-
 def main(comm, config):
     field = data_gen.make_field(config["field"], **config.get("params", {}))
     extras = {"shading": vrlib.Phong(specular=0.3) if config.get("shade") else None,
@@ -65,7 +59,7 @@ def main(comm, config):
                 else:
                     frame = mpi.render_object(comm, source, view, shape=shape,
                                               filter=filt, transfer=transfer,
-                                              compositing=compositor(compositing),
+                                              compositing=compositing,
                                               balance=balance)
                 if comm.Get_rank() == 0:
                     results.append({

@@ -61,7 +61,7 @@ from vrlib.parallel.traffic import Messages, footprint_rect, sum_messages
 __all__ = ["COMPOSITORS", "Compositor", "DirectSend", "BinarySwap", "RadixK", "HEADER",
            "direct_send_messages", "binary_swap_rounds", "binary_swap_messages",
            "radix_k_rounds", "radix_k_messages", "swap_slots",
-           "swap_halves", "split_region", "radix_factors", "gather_to_root"]
+           "swap_halves", "split_region", "radix_factors", "compositor", "gather_to_root"]
 
 
 class Compositor:
@@ -611,6 +611,30 @@ def radix_k_messages(tree, view, origin, spacing, factors, *, bytes_per_pixel=4,
 
 #: Compositors by name.
 COMPOSITORS = {c.name: c for c in (DirectSend(), BinarySwap(), RadixK())}
+
+
+def compositor(spec):
+    """A compositor from a name of :data:`COMPOSITORS`, ``"radix-k:AxB..."`` (radix-k with
+    the factors ``A``, ``B``, ... round by round), or a :class:`Compositor` itself.
+
+    Examples
+    --------
+    >>> compositor("binary-swap"), compositor("radix-k:2x3").factors
+    (COMPOSITORS['binary-swap'], (2, 3))
+    """
+    if isinstance(spec, Compositor):
+        return spec
+    name, _, factors = str(spec).partition(":")
+    if factors and name == "radix-k":
+        try:
+            return RadixK([int(f) for f in factors.split("x")])
+        except ValueError:
+            pass  # not integers: fall through to the message naming the allowed values
+    if factors or name not in COMPOSITORS:
+        allowed = ", ".join(repr(n) for n in COMPOSITORS)
+        raise ValueError(f"unknown compositing {spec!r}: use one of {allowed}, "
+                         "'radix-k:AxB...' or a Compositor")
+    return COMPOSITORS[name]
 
 
 # ---------------------------------------------------------------- the finished image

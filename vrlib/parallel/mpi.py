@@ -34,7 +34,7 @@ from vrlib.arguments import render_arguments
 from vrlib.image import Image, RenderStats
 from vrlib.parallel import rects
 from vrlib.parallel.balance import BALANCE, visible_cells, visible_work, work_split
-from vrlib.parallel.composite import COMPOSITORS, HEADER, Compositor, RadixK, gather_to_root
+from vrlib.parallel.composite import COMPOSITORS, HEADER, RadixK, compositor, gather_to_root
 from vrlib.parallel.decompose import interleaved_owners, screen_tiles, split
 from vrlib.parallel.exchange import Exchange
 from vrlib.parallel.sources import RawFile, ghost, global_value_range, open_source
@@ -116,9 +116,8 @@ def _check(view, filter, transfer, step, compositing=None, balance=None,
                          "prefilter is a recursion along whole lines of the volume, while each "
                          "rank reads only its brick; use a filter applied to the samples "
                          "(e.g. 'catmull-rom'), or vrlib.render on one machine")
-    if compositing is not None and not isinstance(compositing, Compositor):
-        compositing = COMPOSITORS[validate.choice("compositing", compositing,
-                                                  tuple(COMPOSITORS))]
+    if compositing is not None:
+        compositing = compositor(compositing)
     if balance is not None:
         validate.choice("balance", balance, BALANCE)
         validate.positive_int("bricks_per_rank", bricks_per_rank)
@@ -150,8 +149,9 @@ def render_object(comm, source, view, *, shape=None, extent=None, filter="trilin
         ``early_termination=1``.
     compositing : str or Compositor, default "binary-swap"
         A name from :data:`vrlib.parallel.composite.COMPOSITORS` ("binary-swap",
-        "direct-send", "radix-k"), or a compositor such as ``RadixK([2, 3])`` (radix-k with
-        the factors of the rank count given round by round).
+        "direct-send", "radix-k"), ``"radix-k:2x3"`` or ``RadixK([2, 3])`` (radix-k with the
+        factors of the rank count given round by round); see
+        :func:`vrlib.parallel.composite.compositor`.
     balance : {"even", "interleaved", "work"}
         How bricks are cut and dealt (see the module's notes).
     bricks_per_rank : int
