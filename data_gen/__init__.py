@@ -6,6 +6,7 @@
 (16, 16, 16)
 """
 
+from data_gen.datasets import DATASETS, load_dataset, load_mni_template
 from data_gen.fields import (
     BlobSum,
     Field,
@@ -16,12 +17,17 @@ from data_gen.fields import (
     StepEdge,
 )
 from data_gen.loaders import (
+    FORMATS,
     fitted_extent,
     load,
-    load_mni_template,
+    load_den,
+    load_dicom,
     load_nifti,
     load_npy,
+    load_nrrd,
     load_raw,
+    load_tiff,
+    load_vtk,
 )
 from vrlib import validate
 
@@ -78,6 +84,14 @@ __all__ = [
     "load_npy",
     "load_nifti",
     "load_raw",
+    "load_nrrd",
+    "load_tiff",
+    "load_vtk",
+    "load_dicom",
+    "load_den",
+    "FORMATS",
+    "DATASETS",
+    "load_dataset",
     "load_mni_template",
     "fitted_extent",
 ]

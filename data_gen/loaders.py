@@ -1,34 +1,38 @@
-"""Loaders for user volumes (.npy, NIfTI, raw) and the real MRI template inside nilearn.
+"""Loaders for volume files: ``.npy``, raw, NIfTI, NRRD, TIFF stacks, VTK image data, DICOM
+series and VolPack's ``.den``; :func:`load` tells them apart.
 
-Every loader returns a :class:`vrlib.Volume` with data ``[z, y, x]``. By default the world box
-is centred on the origin and scaled so that its longest side spans [-1, 1], which frames it in
-the default views; pass ``extent`` (or ``physical=True`` for NIfTI) to keep other units.
+Every loader returns a :class:`vrlib.Volume` with data ``[z, y, x]`` in the file's own units:
+the voxel spacing and origin its header gives (millimetres for medical formats), or one unit
+per voxel from the origin where the format has no header (``.npy``, raw). Views built from
+angles alone frame any volume (:meth:`vrlib.View.fitted`), so no rescaling is needed; pass
+``extent`` (e.g. :func:`fitted_extent`) to place a volume in another box.
+
+Orientation: NIfTI volumes are turned to the closest RAS+ axes of their affine (a LAS file
+renders as its RAS twin); DICOM slices are ordered along their normal. A rotation left over
+after that (an oblique acquisition) is not applied: the voxels stay on axis-aligned axes.
 """
 
 from __future__ import annotations
 
+import logging
+import math
 from pathlib import Path
 
 import numpy as np
 
 from vrlib import validate
-from vrlib.volume import Volume
+from vrlib.volume import Volume, fitted_extent
 
-__all__ = ["load", "load_npy", "load_nifti", "load_raw", "load_mni_template", "fitted_extent"]
+__all__ = ["load", "load_npy", "load_nifti", "load_raw", "load_nrrd", "load_tiff", "load_vtk",
+           "load_dicom", "load_den", "fitted_extent", "nifti_orientation", "nifti_volume",
+           "FORMATS"]
 
-
-def fitted_extent(shape, spacing=(1.0, 1.0, 1.0)):
-    """World box for a ``(nz, ny, nx)`` lattice of ``(dx, dy, dz)`` spacing, centred on the
-    origin with its longest side spanning [-1, 1].
-
-    Examples
-    --------
-    >>> fitted_extent((2, 3, 5)).tolist()
-    [[-1.0, 1.0], [-0.5, 0.5], [-0.25, 0.25]]
-    """
-    sizes = (np.array(shape[::-1], dtype=np.float64) - 1.0) * np.asarray(spacing, dtype=float)
-    half = sizes / sizes.max()
-    return np.stack([-half, half], axis=1)
+#: File kinds :func:`load` reads, by name ending (a DICOM series is a folder).
+FORMATS = {".npy": "NumPy array", ".nii": "NIfTI", ".nii.gz": "NIfTI (gzip)",
+           ".raw": "raw samples (shape and dtype given)", ".nrrd": "NRRD", ".nhdr": "NRRD header",
+           ".tif": "TIFF stack", ".tiff": "TIFF stack", ".vti": "VTK XML image data",
+           ".vtk": "VTK legacy structured points", ".den": "VolPack density",
+           "folder": "DICOM series"}
 
 
 def _existing(path):
@@ -38,22 +42,48 @@ def _existing(path):
     return path
 
 
-def load_npy(path, *, extent=None):
-    """Load a 3-D ``.npy`` array stored ``[z, y, x]``.
+def _unreadable(path, kind, error):
+    text = str(error).splitlines()[0] if str(error) else type(error).__name__
+    return ValueError(f"{Path(path).name} is not a readable {kind} file: {text}")
+
+
+def _volume(data, extent, spacing, origin):
+    """A volume with ``extent`` if given, else ``spacing`` and ``origin`` (defaults 1, 0)."""
+    if extent is not None:
+        return Volume(data, extent, copy=False)
+    return Volume(data, spacing=(1.0, 1.0, 1.0) if spacing is None else spacing,
+                  origin=(0.0, 0.0, 0.0) if origin is None else origin, copy=False)
+
+
+def load_npy(path, *, spacing=None, origin=None, extent=None):
+    """Load a 3-D ``.npy`` array stored ``[z, y, x]`` (memory-mapped while it is checked).
+
+    Parameters
+    ----------
+    spacing, origin : array_like of 3 floats, optional
+        Voxel size and position of the first sample, ``(x, y, z)``; default 1 and 0.
+    extent : array_like, shape (3, 2), optional
+        The world box instead.
 
     Examples
     --------
     >>> import tempfile, pathlib
     >>> f = pathlib.Path(tempfile.mkdtemp()) / "v.npy"
     >>> np.save(f, np.zeros((2, 3, 4), dtype=np.uint8))
-    >>> load_npy(f).shape
-    (2, 3, 4)
+    >>> vol = load_npy(f)
+    >>> vol.shape, vol.extent.tolist()
+    ((2, 3, 4), [[0.0, 3.0], [0.0, 2.0], [0.0, 1.0]])
     """
-    vol = Volume(np.load(_existing(path), allow_pickle=False), extent, copy=False)
-    return vol if extent is not None else Volume(vol.data, fitted_extent(vol.shape), copy=False)
+    path = _existing(path)
+    try:
+        data = np.load(path, mmap_mode="r", allow_pickle=False)
+    except (ValueError, OSError, EOFError) as error:
+        raise _unreadable(path, ".npy", error) from None
+    return _volume(data, extent, spacing, origin)
 
 
-def load_raw(path, shape, dtype, *, byteorder="little", offset=0, extent=None):
+def load_raw(path, shape, dtype, *, byteorder="little", offset=0, spacing=None, origin=None,
+             extent=None):
     """Load headerless samples of ``shape = (nz, ny, nx)`` and ``dtype``, x varying fastest.
 
     Parameters
@@ -61,6 +91,8 @@ def load_raw(path, shape, dtype, *, byteorder="little", offset=0, extent=None):
     byteorder : {"little", "big"}
     offset : int
         Bytes to skip at the start (a header).
+    spacing, origin, extent
+        As :func:`load_npy`.
 
     Examples
     --------
@@ -75,84 +107,434 @@ def load_raw(path, shape, dtype, *, byteorder="little", offset=0, extent=None):
     if len(shape) != 3:
         raise ValueError(f"shape must be (nz, ny, nx), got {shape!r}")
     validate.choice("byteorder", byteorder, ("little", "big"))
-    dt = np.dtype(dtype).newbyteorder("<" if byteorder == "little" else ">")
+    try:
+        dt = np.dtype(dtype).newbyteorder("<" if byteorder == "little" else ">")
+    except TypeError:
+        raise ValueError(f"dtype must be a numpy sample type (uint8, int16, float32, ...), "
+                         f"got {dtype!r}") from None
     offset = validate.positive_int("offset", offset, minimum=0)
-    expected = offset + int(np.prod(shape)) * dt.itemsize
+    expected = offset + math.prod(shape) * dt.itemsize
     actual = path.stat().st_size
     if actual != expected:
         raise ValueError(
             f"raw file holds {actual} bytes, but shape {shape} of {dt.name} after {offset} "
             f"header bytes needs {expected}"
         )
-    data = np.fromfile(path, dtype=dt, offset=offset).reshape(shape)
-    return Volume(data, fitted_extent(shape) if extent is None else extent)
+    data = np.memmap(path, dtype=dt, mode="r", offset=offset, shape=shape)
+    return _volume(data, extent, spacing, origin)
 
 
-def _from_nifti_image(img, physical):
-    data = np.asarray(img.get_fdata(dtype=np.float32))
-    if data.ndim == 4 and data.shape[3] == 1:
-        data = data[..., 0]
-    if data.ndim != 3:
-        raise ValueError(f"NIfTI image must be 3-D, got shape {data.shape}")
-    data = np.ascontiguousarray(data.transpose(2, 1, 0))  # (i, j, k) -> [z, y, x]
-    spacing = np.asarray(img.header.get_zooms()[:3], dtype=np.float64)
-    if physical:
-        sizes = (np.array(data.shape[::-1]) - 1.0) * spacing
-        extent = np.stack([-sizes / 2, sizes / 2], axis=1)
-    else:
-        extent = fitted_extent(data.shape, spacing)
-    return Volume(data, extent, copy=False)
+def nifti_orientation(image):
+    """How a NIfTI image's voxel axes turn to RAS+: ``(ornt, spacing, origin)``.
+
+    ``ornt`` is nibabel's orientation array (apply it with
+    ``nibabel.orientations.apply_orientation`` to ``(i, j, k)`` data); ``spacing`` and
+    ``origin`` are the RAS+ voxel sizes and the position of the reoriented first voxel, in
+    the file's units (mm).
+
+    Examples
+    --------
+    >>> import nibabel
+    >>> las = np.diag([-2.0, 1.0, 1.0, 1.0]); las[0, 3] = 10.0      # x = 10 - 2 i
+    >>> ornt, spacing, origin = nifti_orientation(nibabel.Nifti1Image(np.zeros((6, 2, 2)), las))
+    >>> ornt.tolist(), spacing.tolist(), origin.tolist()
+    ([[0.0, -1.0], [1.0, 1.0], [2.0, 1.0]], [2.0, 1.0, 1.0], [0.0, 0.0, 0.0])
+    """
+    import nibabel
+    from nibabel import orientations
+
+    affine = np.asarray(image.affine, dtype=np.float64)
+    shape = image.shape[:3]
+    ornt = orientations.io_orientation(affine)
+    transform = orientations.inv_ornt_aff(ornt, shape)
+    canonical = affine @ transform
+    spacing = np.asarray(nibabel.affines.voxel_sizes(canonical), dtype=np.float64)
+    return ornt, spacing, canonical[:3, 3].copy()
 
 
-def load_nifti(path, *, physical=False):
-    """Load a NIfTI volume (``.nii``/``.nii.gz``) through nibabel, in voxel-axis order.
+def load_nifti(path, *, frame=None, extent=None):
+    """Load a NIfTI volume (``.nii``, ``.nii.gz``) through nibabel, turned to RAS+.
 
-    Voxel axes ``(i, j, k)`` become ``(x, y, z)``; the voxel sizes set the aspect. With
-    ``physical=True`` the world box is in the file's units (mm), centred on the origin.
+    Voxel axes become ``(x, y, z)`` = (right, anterior, superior) after the flips and swaps
+    the affine asks for (:func:`nifti_orientation`), so a left-to-right (LAS) file renders as
+    its RAS twin, not mirrored; the voxel sizes and origin come from the affine (mm).
+    Scaling (slope, intercept) is applied.
+
+    Parameters
+    ----------
+    frame : int, optional
+        The volume to take from a 4-D file (a time series); required there.
+    extent : array_like, shape (3, 2), optional
+        The world box instead of the affine's.
 
     Examples
     --------
     >>> import nibabel, tempfile, pathlib
     >>> f = pathlib.Path(tempfile.mkdtemp()) / "v.nii.gz"
-    >>> nibabel.save(nibabel.Nifti1Image(np.zeros((5, 3, 2), np.float32), np.eye(4)), f)
+    >>> affine = np.diag([2.0, 1.0, 1.0, 1.0])
+    >>> nibabel.save(nibabel.Nifti1Image(np.zeros((5, 3, 2), np.float32), affine), f)
     >>> vol = load_nifti(f)
     >>> vol.shape, vol.extent[0].tolist()
-    ((2, 3, 5), [-1.0, 1.0])
+    ((2, 3, 5), [0.0, 8.0])
     """
     import nibabel
 
-    return _from_nifti_image(nibabel.load(_existing(path)), physical)
+    path = _existing(path)
+    try:
+        image = nibabel.load(path)
+    except (OSError, EOFError, ValueError, nibabel.filebasedimages.ImageFileError) as error:
+        raise _unreadable(path, "NIfTI", error) from None
+    return nifti_volume(image, path.name, frame=frame, extent=extent)
 
 
-def load_mni_template(*, resolution=2, physical=False):
-    """The MNI152 T1 template bundled inside nilearn (no download): a real MRI volume.
-
-    Raises
-    ------
-    ImportError
-        If nilearn is not installed (``pip install 'vrlib[mri]'``).
+def nifti_volume(image, name, *, frame=None, extent=None):
+    """The volume of a loaded nibabel image (as :func:`load_nifti`; ``name`` for messages).
 
     Examples
     --------
-    >>> load_mni_template().shape        # [z, y, x] at 2 mm
-    (95, 117, 99)
+    >>> import nibabel
+    >>> image = nibabel.Nifti1Image(np.zeros((4, 3, 2), np.float32), np.diag([3, 2, 1, 1]))
+    >>> nifti_volume(image, "in memory").spacing.tolist()
+    [3.0, 2.0, 1.0]
     """
+    from nibabel import orientations
+
+    shape = tuple(int(n) for n in image.shape)
+    if len(shape) not in (3, 4):
+        raise ValueError(f"{name}: a NIfTI volume must be 3-D (or 4-D with frame=), got "
+                         f"shape {shape}")
+    if len(shape) == 3 and frame not in (None, 0):
+        raise ValueError(f"frame: {name} is 3-D, it has no frame {frame}")
+    proxy = image.dataobj
     try:
-        from nilearn.datasets import load_mni152_template
-    except ImportError as exc:
-        raise ImportError(
-            "the MRI template ships inside nilearn: install it with pip install 'vrlib[mri]'"
-        ) from exc
-    if resolution not in (1, 2):
-        raise ValueError(f"resolution must be 1 or 2 (mm), got {resolution!r}")
-    return _from_nifti_image(load_mni152_template(resolution=resolution), physical)
+        data = np.asarray(proxy[..., _frame(name, shape, frame)] if len(shape) == 4
+                          else proxy, dtype=np.float64)
+    except (OSError, EOFError, ValueError) as error:
+        if str(error).startswith("frame"):
+            raise
+        raise ValueError(f"{name} is not a readable NIfTI file: {error}") from None
+    ornt, spacing, origin = nifti_orientation(image)
+    data = orientations.apply_orientation(data, ornt)
+    data = np.ascontiguousarray(data.transpose(2, 1, 0))  # (i, j, k) -> [z, y, x]
+    return _volume(data, extent, spacing, origin)
+
+
+def _frame(name, shape, frame):
+    """The frame to take from a 4-D image of ``shape``, checked."""
+    if frame is None:
+        if shape[3] == 1:
+            return 0
+        raise ValueError(f"frame: {name} holds {shape[3]} volumes (4-D): choose one with "
+                         f"frame=0..{shape[3] - 1} (--frame on the command line)")
+    if not isinstance(frame, int | np.integer) or not 0 <= frame < shape[3]:
+        raise ValueError(f"frame must be an integer 0..{shape[3] - 1} for {name}, got "
+                         f"{frame!r}")
+    return int(frame)
+
+
+def load_nrrd(path, *, extent=None):
+    """Load an NRRD file (``.nrrd``, or ``.nhdr`` with its data file) through pynrrd.
+
+    Spacing from ``space directions`` (their lengths) or ``spacings``; origin from
+    ``space origin``.
+
+    Examples
+    --------
+    >>> import nrrd, tempfile, pathlib
+    >>> f = str(pathlib.Path(tempfile.mkdtemp()) / "v.nrrd")
+    >>> nrrd.write(f, np.zeros((4, 3, 2), np.int16), {"spacings": [0.5, 1.0, 2.0]})
+    >>> vol = load_nrrd(f)
+    >>> vol.shape, vol.spacing.tolist()
+    ((2, 3, 4), [0.5, 1.0, 2.0])
+    """
+    import nrrd
+
+    path = _existing(path)
+    try:
+        data, header = nrrd.read(str(path), index_order="C")
+    except Exception as error:  # pynrrd raises NRRDError, ValueError, OSError and others
+        raise _unreadable(path, "NRRD", error) from None
+    if data.ndim != 3:
+        raise ValueError(f"{path.name} must hold a 3-D volume, got {data.ndim} dimension(s) "
+                         f"of shape {data.shape}")
+    spacing = None
+    if header.get("space directions") is not None:
+        directions = np.array([d for d in header["space directions"] if d is not None],
+                              dtype=np.float64)
+        if directions.shape == (3, 3) and np.all(np.isfinite(directions)):
+            spacing = np.linalg.norm(directions, axis=1)
+    elif header.get("spacings") is not None:
+        spacing = np.asarray(header["spacings"], dtype=np.float64)
+    origin = header.get("space origin")
+    return _volume(data, extent, spacing, None if origin is None else np.asarray(origin, float))
+
+
+def load_tiff(path, *, spacing=None, extent=None):
+    """Load a TIFF stack (one page per z slice, or an ImageJ hyperstack of one channel)
+    through tifffile, memory-mapped when the file is uncompressed.
+
+    ImageJ's ``spacing`` (z) and the resolution tags (x, y) give the voxel size when
+    ``spacing`` is not passed.
+
+    Examples
+    --------
+    >>> import tifffile, tempfile, pathlib
+    >>> f = pathlib.Path(tempfile.mkdtemp()) / "v.tif"
+    >>> tifffile.imwrite(f, np.zeros((3, 4, 5), np.uint16), imagej=True,
+    ...                  resolution=(2.0, 2.0), metadata={"spacing": 1.5})
+    >>> vol = load_tiff(f)
+    >>> vol.shape, vol.spacing.tolist()
+    ((3, 4, 5), [0.5, 0.5, 1.5])
+    """
+    import tifffile
+
+    path = _existing(path)
+    quiet = logging.getLogger("tifffile")
+    level = quiet.level
+    quiet.setLevel(logging.CRITICAL)  # its warnings become this loader's one-line errors
+    try:
+        with tifffile.TiffFile(path) as tif:
+            if not tif.series or not len(tif.pages):
+                raise ValueError("it holds no images")
+            series = tif.series[0]
+            found = _tiff_spacing(tif)
+            try:
+                data = tifffile.memmap(path)
+            except (ValueError, OSError):  # compressed or scattered pages: read them
+                data = series.asarray()
+    except Exception as error:  # tifffile raises TiffFileError, ValueError and others
+        raise _unreadable(path, "TIFF", error) from None
+    finally:
+        quiet.setLevel(level)
+    data = np.squeeze(data)
+    if data.ndim != 3:
+        raise ValueError(f"{path.name} must hold a 3-D stack of one channel, got shape "
+                         f"{data.shape} (axes {series.axes})")
+    return _volume(data, extent, found if spacing is None else spacing, None)
+
+
+def _tiff_spacing(tif):
+    """(x, y, z) voxel size from the resolution tags and ImageJ's spacing, or None."""
+    page = tif.pages[0]
+    z = (tif.imagej_metadata or {}).get("spacing")
+    tags = page.tags
+    if "XResolution" not in tags or "YResolution" not in tags or z is None:
+        return None
+    (xn, xd), (yn, yd) = tags["XResolution"].value, tags["YResolution"].value
+    if not (xn and yn):
+        return None
+    return (xd / xn, yd / yn, float(z))
+
+
+def load_vtk(path, *, scalars=None, extent=None):
+    """Load VTK image data (``.vti``, or a legacy ``.vtk`` of structured points) through
+    pyvista: its point scalars, origin and spacing.
+
+    Data on cells (one value per voxel, e.g. a label volume written as cell data) becomes a
+    lattice of the cell centres, one sample per cell, shifted by half a cell.
+
+    Parameters
+    ----------
+    scalars : str, optional
+        The array to take (point or cell data); default the active scalars.
+
+    Examples
+    --------
+    >>> import pyvista, tempfile, pathlib
+    >>> grid = pyvista.ImageData(dimensions=(4, 3, 2), spacing=(0.5, 1, 2), origin=(1, 0, 0))
+    >>> grid.point_data["v"] = np.arange(24.0)
+    >>> f = pathlib.Path(tempfile.mkdtemp()) / "v.vti"
+    >>> grid.save(f)
+    >>> load_vtk(f).extent.tolist()
+    [[1.0, 2.5], [0.0, 2.0], [0.0, 2.0]]
+    """
+    import pyvista
+
+    path = _existing(path)
+    try:
+        grid = pyvista.read(path)
+    except Exception as error:  # VTK readers raise many kinds, or return an empty dataset
+        raise _unreadable(path, "VTK", error) from None
+    if not isinstance(grid, pyvista.ImageData) or grid.n_points == 0:
+        raise ValueError(f"{path.name} must hold VTK image data (a regular grid), got "
+                         f"{type(grid).__name__} with {grid.n_points} points")
+    points, cells = list(grid.point_data.keys()), list(grid.cell_data.keys())
+    name = scalars if scalars is not None else grid.active_scalars_name or (
+        points[0] if points else cells[0] if cells else None)
+    if name is None or (name not in points and name not in cells):
+        raise ValueError(f"{path.name}: no array {name!r}; point arrays {points}, cell arrays "
+                         f"{cells} (choose one with scalars=)")
+    if name in points:
+        volume = Volume.from_pyvista(grid, name)
+        return volume if extent is None else Volume(volume.data, extent, copy=False)
+    nx, ny, nz = (n - 1 for n in grid.dimensions)
+    values = np.asarray(grid.cell_data[name])
+    if values.ndim != 1:
+        raise ValueError(f"{path.name}: array {name!r} must hold one value per cell, got "
+                         f"shape {values.shape}")
+    spacing = np.asarray(grid.spacing, dtype=np.float64)
+    origin = np.asarray(grid.origin, dtype=np.float64) + spacing / 2
+    return _volume(values.reshape(nz, ny, nx), extent, spacing, origin)
+
+
+def load_dicom(folder, *, series=None, extent=None):
+    """Load a DICOM series (a folder of slice files) through pydicom.
+
+    Slices are ordered by their position along the slice normal (``ImagePositionPatient``
+    against ``ImageOrientationPatient``); x and y spacing come from ``PixelSpacing``, z from
+    the distance between positions, and each slice's ``RescaleSlope`` and
+    ``RescaleIntercept`` are applied. A folder with several series needs ``series`` (a
+    ``SeriesInstanceUID``, or its last digits); missing slices (an uneven gap) and slices of
+    other sizes are refused.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> from data_gen.dicom import write_series
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> files = write_series(folder, np.zeros((3, 4, 5), np.int16), spacing=(0.5, 0.5, 2.0))
+    >>> vol = load_dicom(folder)
+    >>> vol.shape, vol.spacing.tolist()
+    ((3, 4, 5), [0.5, 0.5, 2.0])
+    """
+    import pydicom
+    from pydicom.errors import InvalidDicomError
+
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise FileNotFoundError(f"no DICOM folder at {str(folder)!r}")
+    slices = {}
+    for file in sorted(p for p in folder.iterdir() if p.is_file()):
+        try:
+            ds = pydicom.dcmread(file, stop_before_pixels=False)
+        except (InvalidDicomError, OSError, EOFError):
+            continue
+        except Exception as error:  # pydicom raises many kinds on a corrupt file
+            raise _unreadable(file, "DICOM", error) from None
+        if "PixelData" not in ds:
+            continue
+        slices.setdefault(str(ds.get("SeriesInstanceUID", "")), []).append((file, ds))
+    if not slices:
+        raise ValueError(f"no DICOM slices with pixel data in {str(folder)!r}")
+    if series is None and len(slices) > 1:
+        raise ValueError(f"{folder.name} holds {len(slices)} DICOM series: choose one with "
+                         f"series= (one of {sorted(slices)})")
+    if series is not None:
+        chosen = [uid for uid in slices if uid == series or uid.endswith(str(series))]
+        if len(chosen) != 1:
+            raise ValueError(f"series {series!r} names {len(chosen)} of the series in "
+                             f"{folder.name}: {sorted(slices)}")
+        series = chosen[0]
+    else:
+        series = next(iter(slices))
+    members = slices[series]
+    if len(members) < 2:
+        raise ValueError(f"a DICOM series needs at least 2 slices, {folder.name} has "
+                         f"{len(members)}")
+    return _stack_dicom(folder, members, extent)
+
+
+def _stack_dicom(folder, members, extent):
+    first = members[0][1]
+    try:
+        cosines = np.asarray(first.ImageOrientationPatient, dtype=np.float64).reshape(2, 3)
+        pixel = np.asarray(first.PixelSpacing, dtype=np.float64)  # (row, column) spacing
+    except AttributeError as error:
+        raise ValueError(f"{members[0][0].name} lacks the geometry of a volume slice "
+                         f"({error})") from None
+    normal = np.cross(cosines[0], cosines[1])
+    positions = []
+    for file, ds in members:
+        if "ImagePositionPatient" not in ds:
+            raise ValueError(f"{file.name} has no ImagePositionPatient: cannot order slices")
+        positions.append(float(np.dot(np.asarray(ds.ImagePositionPatient, float), normal)))
+    order = np.argsort(positions)
+    depth = np.diff(np.asarray(positions)[order])
+    if np.any(depth <= 0):
+        raise ValueError(f"{folder.name}: two slices share a position: a repeated slice or "
+                         "mixed series")
+    gap = float(np.median(depth))
+    if np.any(np.abs(depth - gap) > 0.01 * gap):
+        worst = int(np.argmax(np.abs(depth - gap)))
+        raise ValueError(f"{folder.name}: slices are unevenly spaced ({depth[worst]:g} against "
+                         f"{gap:g} mm between positions {positions[order[worst]]:g} and "
+                         f"{positions[order[worst + 1]]:g}): missing slices?")
+    planes = []
+    for index in order:
+        file, ds = members[index]
+        try:
+            plane = ds.pixel_array.astype(np.float64)
+        except Exception as error:
+            raise _unreadable(file, "DICOM", error) from None
+        if planes and plane.shape != planes[0].shape:
+            raise ValueError(f"{file.name} is {plane.shape}, other slices "
+                             f"{planes[0].shape}: not one series")
+        slope = float(ds.get("RescaleSlope", 1.0))
+        planes.append(plane * slope + float(ds.get("RescaleIntercept", 0.0)))
+    data = np.stack(planes)
+    first = members[order[0]][1]
+    origin = np.asarray(first.ImagePositionPatient, dtype=np.float64)
+    return _volume(data, extent, (pixel[1], pixel[0], gap), origin)
+
+
+# VolPack's .den header (Levoy's format): 28 shorts (version, then original, extracted and
+# mapped minimum, maximum and length per axis), the map's warp count and its length in bytes.
+_DEN_HEADER = 62
+
+
+def load_den(path, *, extent=None):
+    """Load a VolPack/Levoy ``.den`` density file (8-bit samples after a 62-byte header whose
+    mapped lengths give the shape; either byte order, told by the version word).
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> f = pathlib.Path(tempfile.mkdtemp()) / "v.den"
+    >>> header = np.zeros(29, ">i2"); header[[0, 25, 26, 27]] = (1, 4, 3, 2)
+    >>> with open(f, "wb") as out:
+    ...     _ = out.write(header.tobytes() + np.array([24], ">i4").tobytes() + bytes(range(24)))
+    >>> vol = load_den(f)
+    >>> vol.shape, float(vol.data[1, 2, 3])
+    ((2, 3, 4), 23.0)
+    """
+    path = _existing(path)
+    raw = path.read_bytes()
+    if len(raw) < _DEN_HEADER:
+        raise ValueError(f"{path.name} is not a .den file: {len(raw)} bytes, shorter than its "
+                         f"{_DEN_HEADER}-byte header")
+    for order in (">", "<"):  # the version word is 1 in the file's byte order
+        version = int(np.frombuffer(raw, dtype=order + "i2", count=1)[0])
+        lengths = np.frombuffer(raw, dtype=order + "i2", count=3, offset=50).astype(int)
+        size = int(np.frombuffer(raw, dtype=order + "i4", count=1, offset=58)[0])
+        if version == 1:
+            break
+    else:
+        raise ValueError(f"{path.name} is not a .den file: its version word is not 1 in "
+                         "either byte order")
+    if np.any(lengths < 2) or size != math.prod(lengths.tolist()):
+        raise ValueError(f"{path.name} is not a .den file: its header's map lengths "
+                         f"{lengths.tolist()} and size {size} disagree")
+    if len(raw) != _DEN_HEADER + size:
+        raise ValueError(f"{path.name} holds {len(raw) - _DEN_HEADER} sample bytes, but its "
+                         f"header says {size} ({'x'.join(map(str, lengths))}): truncated?")
+    nx, ny, nz = lengths.tolist()
+    data = np.frombuffer(raw, dtype=np.uint8, offset=_DEN_HEADER).reshape(nz, ny, nx)
+    return _volume(data, extent, None, None)
 
 
 def load(source, **options):
-    """Load a volume from a file (by suffix) or the name ``"mni152"``.
+    """Load a volume from a file, a DICOM folder, or a named real volume
+    (:data:`data_gen.datasets.DATASETS`: ``mni152``, ``frog``, ``aniso``, ``brainsmall``).
 
-    ``.npy`` -> :func:`load_npy`; ``.nii``/``.nii.gz`` -> :func:`load_nifti`; ``.raw`` ->
-    :func:`load_raw` (``shape`` and ``dtype`` required in ``options``).
+    The file's name ending picks the loader (:data:`FORMATS`); ``options`` go to it (a raw
+    file needs ``shape`` and ``dtype``).
+
+    Raises
+    ------
+    FileNotFoundError
+        No such file or folder.
+    ValueError
+        An unknown format, or a file its loader cannot read (the message names the problem).
 
     Examples
     --------
@@ -162,16 +544,26 @@ def load(source, **options):
     >>> load(f, shape=(2, 2, 2), dtype="float32").value_range
     (1.0, 1.0)
     """
-    if str(source) == "mni152":
-        return load_mni_template(**options)
-    name = Path(source).name.lower()
-    if name.endswith(".npy"):
-        return load_npy(source, **options)
-    if name.endswith((".nii", ".nii.gz")):
-        return load_nifti(source, **options)
-    if name.endswith(".raw"):
-        return load_raw(source, **options)
-    raise ValueError(
-        f"cannot tell the format of {str(source)!r}: use .npy, .nii, .nii.gz, .raw "
-        "or the name 'mni152'"
-    )
+    from data_gen import datasets
+
+    if str(source) in datasets.DATASETS:
+        return datasets.load_dataset(str(source), **options)
+    path = Path(source)
+    if path.is_dir():
+        return load_dicom(path, **options)
+    name = path.name.lower()
+    for ending, loader in ((".npy", load_npy), (".nii", load_nifti), (".nii.gz", load_nifti),
+                           (".raw", load_raw), (".nrrd", load_nrrd), (".nhdr", load_nrrd),
+                           (".tif", load_tiff), (".tiff", load_tiff), (".vti", load_vtk),
+                           (".vtk", load_vtk), (".den", load_den)):
+        if name.endswith(ending):
+            if ending == ".raw" and not {"shape", "dtype"} <= set(options):
+                raise ValueError("a .raw file needs shape=(nz, ny, nx) and dtype= (on the "
+                                 "command line --shape NZ,NY,NX --dtype TYPE)")
+            return loader(path, **options)
+    if not path.exists():
+        raise FileNotFoundError(f"no volume file or folder at {str(source)!r}")
+    endings = ", ".join(e for e in FORMATS if e != "folder")
+    raise ValueError(f"cannot tell the format of {str(source)!r}: use a file ending in "
+                     f"{endings}, a folder of DICOM slices, or one of the named volumes "
+                     f"{', '.join(datasets.DATASETS)}")

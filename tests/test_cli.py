@@ -92,6 +92,11 @@ def test_render_reads_files(tmp_path):
       "-o", "x.png"], "orthographic only"),
     (["render", "marschner-lobb:17", "--projection", "perspective", "--classified",
       "-o", "x.png"], "orthographic views only"),
+    (["render", "frog", "--opacity", "0:0;1", "-o", "x.png"], "opacity points must be"),
+    (["render", "frog", "--opacity", "0:0,1:2", "-o", "x.png"], "alpha must lie in [0, 1]"),
+    (["render", "frog", "--cmap", "nosuchmap", "-o", "x.png"], "unknown colormap"),
+    (["render", "frog", "--clim", "0,1", "-o", "x.png"], "--clim applies with --opacity"),
+    (["render", "frog", "--frame", "1", "-o", "x.png"], "--frame applies to .nii"),
 ])
 def test_bad_input_exits_2_with_one_line(tmp_path, args, message):
     done = run(*args, cwd=tmp_path)
@@ -99,6 +104,58 @@ def test_bad_input_exits_2_with_one_line(tmp_path, args, message):
     lines = done.stderr.strip().splitlines()
     assert len(lines) == 1 and message in lines[0], done.stderr
     assert not any(tmp_path.iterdir()), "nothing may be written on bad input"
+
+
+def test_bad_files_exit_2_with_one_line(tmp_path):
+    """Truncated and corrupt files of each kind: one line naming the problem, nothing written."""
+    inputs, out = tmp_path / "in", tmp_path / "out"
+    inputs.mkdir()
+    out.mkdir()
+    np.zeros((4, 4, 4), np.uint8).tofile(inputs / "short.raw")
+    (inputs / "bad.nii").write_bytes(b"\x5c\x01" + bytes(300))
+    (inputs / "bad.tif").write_bytes(b"II*\x00" + bytes(8))
+    (inputs / "v.xyz").write_bytes(b"")
+    np.save(inputs / "v.npy", np.zeros((4, 4, 4)))
+    for args, message in (
+            (["short.raw", "--shape", "4,4,5", "--dtype", "uint8"], "raw file holds 64 bytes"),
+            (["bad.nii"], "not a readable NIfTI file"),
+            (["bad.tif"], "not a readable TIFF file"),
+            (["v.xyz"], "unknown volume"),
+            (["v.npy", "--offset", "8"], "--offset applies to .raw files only")):
+        args[0] = str(inputs / args[0])
+        done = run("render", *args, "-o", "x.png", cwd=out)
+        lines = done.stderr.strip().splitlines()
+        assert done.returncode == 2 and len(lines) == 1 and message in lines[0], done.stderr
+    assert not any(out.iterdir())
+
+
+def test_real_volumes_render_by_name_with_their_transfer_functions(tmp_path):
+    """Each shipped volume in one command, with a colormap and opacity points or the
+    automatic ramp, comes out as a picture (not empty, not a white silhouette)."""
+    for name, extra in (("frog", ["--cmap", "bone", "--opacity", "0:0,0.2:0,1:0.6", "--clim",
+                                  "0,29", "--shade"]),
+                        ("aniso", []), ("mni152", ["--cmap", "magma"])):
+        out = tmp_path / f"{name}.npy"
+        done = run("render", name, *extra, "--size", "24", "--filter", "trilinear", "-o",
+                   str(out))
+        assert done.returncode == 0, done.stderr
+        alpha = np.load(out)[..., 3]
+        assert 0.02 < alpha.mean() < 0.6 and alpha.max() > 0.3, (name, alpha.mean())
+    done = run("info", "aniso")
+    assert done.returncode == 0, done.stderr
+    assert "spacing (x, y, z): 4, 4, 5" in done.stdout and "histogram" in done.stdout
+
+
+def test_render_a_dicom_folder(tmp_path):
+    from data_gen.dicom import write_series
+
+    data = np.zeros((6, 8, 8))
+    data[1:5, 2:6, 2:6] = 500
+    write_series(tmp_path / "ct", data - 1000, spacing=(0.5, 0.5, 1.0), intercept=-1024)
+    out = tmp_path / "ct.npy"
+    done = run("render", str(tmp_path / "ct"), "--size", "16", "-o", str(out))
+    assert done.returncode == 0, done.stderr
+    assert np.load(out)[..., 3].max() > 0.1
 
 
 def test_argparse_errors_exit_2():

@@ -264,9 +264,12 @@ def test_image_partition_in_process_and_from_a_file(tmp_path):
     path = tmp_path / "blob.npy"
     np.save(path, vol.data)
     view = vrlib.View.orbit(azimuth=-20, elevation=40, size=24, projection="perspective")
-    serial = vrlib.render(vol, view, early_termination=1.0)
+    serial = vrlib.render(data_gen.load(path), view, transfer=vrlib.Glow(0.125),
+                          early_termination=1.0)
+    assert serial.alpha.max() > 0.3
     for layout in ("contiguous", "interleaved"):
-        frame = mpi.render_image(MPI.COMM_SELF, path, view, layout=layout, tile=5)
+        frame = mpi.render_image(MPI.COMM_SELF, path, view, layout=layout, tile=5,
+                                 transfer=vrlib.Glow(0.125))
         assert np.abs(frame.image.rgba - serial.rgba).max() < TOLERANCE
 
 

@@ -178,7 +178,8 @@ def test_images_converge_as_the_step_shrinks():
 def test_views_that_miss_give_a_transparent_image():
     vol = small_volume()
     off = View.orbit(size=8, center=(10, 10, 10), radius=0.5)
-    img = render(vol, off)
+    with pytest.warns(vrlib.EmptyImageWarning, match="lies outside the view"):
+        img = render(vol, off)
     assert np.array_equal(img.rgba, np.zeros((8, 8, 4)))
     assert img.stats.samples == 0
 

@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 import data_gen
+import vrlib
 from vrlib import Glow, LookupTransfer, Phong, View, compositing, render_reference
 from vrlib.reference import _clip_to_box
 
@@ -76,7 +77,8 @@ def test_shading_uses_the_field_gradient():
 
 def test_rays_that_miss_and_partial_boxes():
     field = data_gen.make_field("gaussian-blob")
-    img = render_reference(field, View.orbit(size=6, center=(9, 9, 9), radius=0.5))
+    with pytest.warns(vrlib.EmptyImageWarning, match="lies outside the view"):
+        img = render_reference(field, View.orbit(size=6, center=(9, 9, 9), radius=0.5))
     assert np.array_equal(img.rgba, np.zeros((6, 6, 4)))
     sub = render_reference(field, View.orbit(size=6), extent=[[0, 1], [0, 1], [0, 1]])
     assert 0 < sub.alpha.max() < 1

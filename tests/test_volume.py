@@ -7,20 +7,45 @@ from hypothesis import strategies as st
 from hypothesis.extra import numpy as hnp
 
 from vrlib import Volume
+from vrlib.volume import DEFAULT_EXTENT
 
 
 def test_defaults_and_geometry():
+    """With no world box given, voxels are cubes and the longest side spans [-1, 1]: a
+    non-cubic array is not stretched to the cube."""
     vol = Volume(np.arange(2 * 3 * 5, dtype=float).reshape(2, 3, 5))
     assert vol.shape == (2, 3, 5)
-    np.testing.assert_array_equal(vol.extent, [[-1, 1], [-1, 1], [-1, 1]])
-    np.testing.assert_allclose(vol.spacing, [0.5, 1.0, 2.0])
+    np.testing.assert_array_equal(vol.extent, [[-1, 1], [-0.5, 0.5], [-0.25, 0.25]])
+    np.testing.assert_allclose(vol.spacing, [0.5, 0.5, 0.5])
     np.testing.assert_allclose(vol.center, [0, 0, 0])
-    assert vol.bounding_radius == pytest.approx(np.sqrt(3))
+    assert vol.bounding_radius == pytest.approx(np.sqrt(1 + 0.25 + 0.0625))
     assert vol.value_range == (0.0, 29.0)
     # Corner samples sit on the corners of the box.
-    np.testing.assert_allclose(vol.index_to_world([4, 2, 1]), [1, 1, 1])
+    np.testing.assert_allclose(vol.index_to_world([4, 2, 1]), [1, 0.5, 0.25])
     np.testing.assert_allclose(vol.world_to_index(vol.index_to_world([1.5, 0.25, 0.5])),
                                [1.5, 0.25, 0.5])
+    cube = Volume(np.zeros((4, 4, 4)))
+    np.testing.assert_array_equal(cube.extent, DEFAULT_EXTENT)
+    # The old stretch to the cube stays one argument away.
+    stretched = Volume(vol.data, extent=DEFAULT_EXTENT)
+    np.testing.assert_allclose(stretched.spacing, [0.5, 1.0, 2.0])
+
+
+def test_spacing_and_origin():
+    """spacing and origin as pyvista's ImageData takes them; each defaults alone."""
+    vol = Volume(np.zeros((3, 4, 5)), spacing=(0.5, 1.0, 2.5), origin=(10, 20, 30))
+    np.testing.assert_allclose(vol.extent, [[10, 12], [20, 23], [30, 35]])
+    np.testing.assert_allclose(vol.spacing, [0.5, 1.0, 2.5])
+    np.testing.assert_allclose(Volume(np.zeros((2, 2, 2)), origin=(1, 2, 3)).extent,
+                               [[1, 2], [2, 3], [3, 4]])
+    np.testing.assert_allclose(Volume(np.zeros((2, 3, 2)), spacing=(2, 2, 2)).extent,
+                               [[0, 2], [0, 4], [0, 2]])
+    for bad, message in (({"spacing": (1, 0, 1)}, "spacing must be positive"),
+                         ({"spacing": (1, 1)}, "spacing must have three"),
+                         ({"origin": (0, np.nan, 0)}, "origin must be finite"),
+                         ({"extent": DEFAULT_EXTENT, "origin": (0, 0, 0)}, "not both")):
+        with pytest.raises(ValueError, match=message):
+            Volume(np.zeros((2, 2, 2)), **bad)
 
 
 def test_anisotropic_extent():
@@ -129,7 +154,8 @@ def test_pyramid_is_cached_and_validated():
 
 def test_repr():
     assert repr(Volume(np.zeros((2, 3, 4)))) == (
-        "Volume(shape=(2, 3, 4), dtype=float64, extent=[[-1, 1], [-1, 1], [-1, 1]])"
+        "Volume(shape=(2, 3, 4), dtype=float64, extent=[[-1, 1], [-0.666667, 0.666667], "
+        "[-0.333333, 0.333333]])"
     )
 
 

@@ -18,7 +18,9 @@ The public API is the list in ``__all__``.
 """
 
 from vrlib import bounds, compositing, cost, filters, metrics, prefilter
+from vrlib.arguments import EmptyImageWarning
 from vrlib.classified import ClassifiedVolume, classify
+from vrlib.colormapping import auto_transfer, colormap
 from vrlib.filters import FILTERS, make_filter
 from vrlib.image import Image, RenderStats
 from vrlib.reconstruction import reconstruct
@@ -42,11 +44,14 @@ __all__ = [
     "View",
     "Glow",
     "LookupTransfer",
+    "colormap",
+    "auto_transfer",
     "Phong",
     "GradientOpacity",
     "TransferFunction",
     "Image",
     "RenderStats",
+    "EmptyImageWarning",
     "make_filter",
     "FILTERS",
     "filters",

@@ -8,12 +8,20 @@ filter is built once (renderers below take a :class:`vrlib.filters.Filter`, neve
 
 from __future__ import annotations
 
+import warnings
+
 from vrlib import validate
 from vrlib.filters import check_radius, make_filter
 from vrlib.transfer import Glow, TransferFunction
-from vrlib.view import View
+from vrlib.view import View, extent_of
 
-__all__ = ["check_view", "check_transfer", "render_arguments", "refuse_gradients"]
+__all__ = ["check_view", "check_transfer", "render_arguments", "refuse_gradients",
+           "framed_view", "EmptyImageWarning"]
+
+
+class EmptyImageWarning(UserWarning):
+    """The image will be empty, and why: the volume lies outside the view, or the transfer
+    function is transparent over every value the volume holds."""
 
 
 def check_view(view):
@@ -30,6 +38,44 @@ def check_transfer(transfer):
         raise TypeError(f"transfer must be a vrlib transfer function (Glow, LookupTransfer), "
                         f"got {transfer!r}")
     return transfer
+
+
+def framed_view(view, extent, transfer=None, value_range=None):
+    """The view that renders a volume of world box ``extent`` (or a Volume, or a field):
+    ``view`` fitted to the box
+    (:meth:`vrlib.View.fitted`) unless it names its own framing. Warns
+    (:class:`EmptyImageWarning`) when the image can only come out empty, saying why.
+
+    Examples
+    --------
+    >>> import vrlib
+    >>> framed_view(vrlib.View.orbit(size=8), [[0, 10], [0, 10], [0, 10]]).center.tolist()
+    [5.0, 5.0, 5.0]
+    >>> import warnings
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     _ = framed_view(vrlib.View.orbit(size=8, radius=1.0), [[0, 1], [50, 60], [0, 1]])
+    >>> str(caught[0].message)[:43]
+    'the volume lies outside the view: its world'
+    """
+    view = check_view(view).fitted(extent)
+    box = extent_of(extent)
+    if not view.sees(box):
+        ext = " x ".join(f"[{lo:g}, {hi:g}]" for lo, hi in box)
+        warnings.warn(
+            f"the volume lies outside the view: its world box {ext} does not reach the image "
+            f"of a view framing centre {view.center.round(4).tolist()}, radius "
+            f"{view.radius:g}; build the view with View.orbit(...) (no centre or radius: it "
+            "frames the volume) or View.fit(volume, ...)", EmptyImageWarning, stacklevel=3)
+    elif transfer is not None and value_range is not None:
+        low, high = value_range
+        if float(transfer.max_density(low, high)) == 0.0:
+            warnings.warn(
+                f"the transfer function {transfer!r} is transparent over all the volume's "
+                f"values [{low:g}, {high:g}]: the image is empty; choose opacity over that "
+                "range (e.g. transfer='auto', or vrlib.colormap(..., clim=volume.value_range))",
+                EmptyImageWarning, stacklevel=3)
+    return view
 
 
 def render_arguments(view, filter, transfer, step, early_termination=1.0):

@@ -29,7 +29,7 @@ from vrlib import validate
 from vrlib._kernels.classified import composite_classified, shade_table
 from vrlib._kernels.shear import warp
 from vrlib._scheduling import balanced_order, thread_count
-from vrlib.arguments import check_transfer, check_view
+from vrlib.arguments import check_transfer, framed_view
 from vrlib.image import Image, RenderStats
 from vrlib.shearwarp import intermediate_plane, warp_homography
 from vrlib.transfer import Phong
@@ -254,7 +254,7 @@ class ClassifiedVolume:
         Image
             Premultiplied RGBA; ``stats.samples`` counts the composited samples.
         """
-        check_view(view)
+        view = framed_view(view, self.volume.extent)
         if view.is_perspective:
             raise ValueError("a ClassifiedVolume renders orthographic views only (as VolPack); "
                              "use vrlib.render(volume, view, method='shearwarp') for perspective")

@@ -16,16 +16,26 @@ import numpy as np
 EXAMPLES = """examples:
   vrlib render marschner-lobb:41 -o ml.png
   vrlib render gaussian-blob:64:sigma=0.3 --method splat --filter catmull-rom -o blob.png
-  vrlib render mni152 --transfer ramp:0.3:40 --shade --azimuth 90 --size 512 -o head.png
-  vrlib render scan.raw --shape 64,64,64 --dtype uint8 -o scan.png
+  vrlib render mni152 --shade --azimuth 90 --size 512 -o head.png
+  vrlib render frog --cmap bone --opacity 0:0,0.2:0,1:0.6 --clim 0,29 --shade -o frog.png
+  vrlib render scan.raw --shape 64,64,64 --dtype uint8 --offset 512 -o scan.png
+  vrlib render dicom_folder/ --cmap gray -o ct.png
+  vrlib info aniso
   vrlib compare marschner-lobb:41 --size 128 -o compare.png
   vrlib bench
   vrlib info
 """
 
 VOLUME_HELP = ("an analytic field NAME[:SAMPLES[:KEY=VALUE...]] (e.g. marschner-lobb:41, "
-               "gaussian-blob:64:sigma=0.3), a file (.npy, .nii, .nii.gz, .raw with --shape "
-               "and --dtype), or mni152 (the bundled MRI template)")
+               "gaussian-blob:64:sigma=0.3); a file (.npy, .nii, .nii.gz, .nrrd, .nhdr, .tif, "
+               ".tiff, .vti, .vtk, .den, or .raw with --shape and --dtype); a folder of DICOM "
+               "slices; or a named real volume: mni152, frog, aniso, brainsmall")
+
+TRANSFER_HELP = ("auto (a grey ramp fitted to the histogram; the default for files and named "
+                 "volumes), glow[:K] (density K x value; the default for analytic fields) or "
+                 "ramp:THRESHOLD:SCALE (transparent below THRESHOLD, a fraction of the value "
+                 "range, then density up to SCALE); glow and ramp densities are per half of the "
+                 "volume's longest side. --cmap and --opacity build a colormap transfer instead")
 
 
 class UsageError(Exception):
@@ -40,27 +50,41 @@ def _number(text):
     return int(value) if value.is_integer() and "." not in text and "e" not in text else value
 
 
-def load_volume(spec, *, shape=None, dtype=None):
+def load_volume(spec, *, shape=None, dtype=None, offset=0, frame=None, series=None,
+                scalars=None):
     """``(volume, field or None)`` from a command-line volume spec."""
     import data_gen
 
     path = Path(spec)
-    if spec == "mni152":
-        return data_gen.load_mni_template(), None
-    if path.suffix in (".npy", ".raw", ".nii", ".gz"):
-        if not path.is_file():
+    name = path.name.lower()
+    if spec in data_gen.DATASETS or path.is_dir() or any(
+            name.endswith(e) for e in data_gen.FORMATS if e != "folder"):
+        if not (spec in data_gen.DATASETS or path.exists()):
             raise UsageError(f"volume file not found: {spec}")
         options = {}
-        if path.suffix == ".raw":
+        if name.endswith(".raw"):
             if shape is None or dtype is None:
                 raise UsageError("a .raw volume needs --shape NZ,NY,NX and --dtype")
-            options = {"shape": shape, "dtype": dtype}
-        return data_gen.load(path, **options), None
-    name, *rest = spec.split(":")
-    if name not in data_gen.FIELDS:
+            options = {"shape": shape, "dtype": dtype, "offset": offset}
+        elif offset:
+            raise UsageError("--offset applies to .raw files only")
+        for key, value, ending in (("frame", frame, (".nii", ".nii.gz")),
+                                   ("scalars", scalars, (".vti", ".vtk"))):
+            if value is not None:
+                if not name.endswith(ending):
+                    raise UsageError(f"--{key} applies to {' and '.join(ending)} files only")
+                options[key] = value
+        if series is not None:
+            if not path.is_dir():
+                raise UsageError("--series applies to a folder of DICOM slices only")
+            options["series"] = series
+        return data_gen.load(spec, **options), None
+    field_name, *rest = spec.split(":")
+    if field_name not in data_gen.FIELDS:
         known = ", ".join(data_gen.FIELDS)
-        raise UsageError(f"unknown volume {spec!r}: not a file, and {name!r} is not a field "
-                         f"(fields: {known}; or mni152)")
+        raise UsageError(f"unknown volume {spec!r}: not a file, and {field_name!r} is not a "
+                         f"field (fields: {known}; named volumes: "
+                         f"{', '.join(data_gen.DATASETS)})")
     samples, params = 64, {}
     for part in rest:
         if "=" in part:
@@ -72,24 +96,51 @@ def load_volume(spec, *, shape=None, dtype=None):
             except ValueError:
                 raise UsageError(f"samples per axis must be an integer, got {part!r}") \
                     from None
-    field = data_gen.make_field(name, **params)
+    field = data_gen.make_field(field_name, **params)
     return field.sample(samples), field
 
 
-def make_transfer(spec, shade=False):
-    """``glow:K`` (default ``glow:1``) or ``ramp:THRESHOLD:SCALE`` (transparent below the
-    threshold, a fraction of the value range); ``shade`` adds Phong shading."""
+def _pair(text, what):
+    try:
+        low, high = (float(v) for v in text.split(","))
+    except ValueError:
+        raise UsageError(f"{what} must be LOW,HIGH (two numbers), got {text!r}") from None
+    return low, high
+
+
+def make_transfer(args, field):
+    """The transfer function the arguments ask for, as a function of the volume."""
     import vrlib
 
-    shading = vrlib.Phong() if shade else None
-
-    kind, *args = spec.split(":")
+    shading = vrlib.Phong() if args.shade else None
+    if args.cmap is not None or args.opacity is not None:
+        if args.transfer is not None:
+            raise UsageError("give either --transfer or --cmap/--opacity, not both")
+        cmap = args.cmap or "gray"
+        clim = None if args.clim is None else _pair(args.clim, "--clim")
+        if args.opacity is None:
+            if clim is not None:
+                raise UsageError("--clim needs --opacity (the automatic ramp finds its own "
+                                 "limits)")
+            return lambda volume: vrlib.auto_transfer(volume, cmap, shading=shading)
+        points = vrlib.colormapping.parse_opacity(args.opacity)
+        return lambda volume: vrlib.colormap(cmap, points, clim=clim, volume=volume,
+                                             shading=shading)
+    if args.clim is not None:
+        raise UsageError("--clim applies with --opacity")
+    spec = args.transfer or ("glow:1" if field is not None else "auto")
+    kind, *numbers = spec.split(":")
+    if kind == "auto" and not numbers:
+        return lambda volume: vrlib.auto_transfer(volume, shading=shading)
     try:
-        numbers = [float(a) for a in args]
+        numbers = [float(a) for a in numbers]
     except ValueError:
         raise UsageError(f"transfer numbers must be numbers, got {spec!r}") from None
     if kind == "glow" and len(numbers) <= 1:
-        return lambda volume: vrlib.Glow(numbers[0] if numbers else 1.0, shading=shading)
+        def glow(volume):
+            return vrlib.Glow((numbers[0] if numbers else 1.0) / _half_side(volume),
+                              shading=shading)
+        return glow
     if kind == "ramp" and len(numbers) == 2:
         threshold, scale = numbers
         if not 0.0 <= threshold < 1.0:
@@ -100,17 +151,22 @@ def make_transfer(spec, shade=False):
             hi = hi if hi > lo else lo + 1.0
             values = np.linspace(0.0, 1.0, 257)
             density = scale * np.clip((values - threshold) / (1.0 - threshold), 0.0, 1.0)
-            return vrlib.LookupTransfer(density, value_range=(lo, hi), shading=shading)
+            return vrlib.LookupTransfer(density / _half_side(volume), value_range=(lo, hi),
+                                        shading=shading)
         return ramp
-    raise UsageError(f"transfer must be glow[:K] or ramp:THRESHOLD:SCALE, got {spec!r}")
+    raise UsageError(f"transfer must be auto, glow[:K] or ramp:THRESHOLD:SCALE, got {spec!r}")
+
+
+def _half_side(volume):
+    """Half the volume's longest side: the unit of the command line's glow and ramp."""
+    return float(np.max(volume.extent[:, 1] - volume.extent[:, 0])) / 2.0
 
 
 def make_view(args, volume):
     import vrlib
 
-    return vrlib.View.orbit(azimuth=args.azimuth, elevation=args.elevation, size=args.size,
-                            projection=args.projection, zoom=args.zoom,
-                            radius=volume.bounding_radius, center=volume.center)
+    return vrlib.View.fit(volume, azimuth=args.azimuth, elevation=args.elevation,
+                          size=args.size, projection=args.projection, zoom=args.zoom)
 
 
 def _shape(text):
@@ -123,14 +179,29 @@ def _shape(text):
     return shape
 
 
-def _add_scene(parser):
-    parser.add_argument("volume", help=VOLUME_HELP)
+def _add_volume(parser, optional=False):
+    parser.add_argument("volume", help=VOLUME_HELP, nargs="?" if optional else None)
     parser.add_argument("--shape", type=_shape, help="NZ,NY,NX of a .raw file")
     parser.add_argument("--dtype", help="sample type of a .raw file (uint8, int16, float32..)")
+    parser.add_argument("--offset", type=int, default=0,
+                        help="header bytes to skip at the start of a .raw file")
+    parser.add_argument("--frame", type=int, help="the volume to take from a 4-D NIfTI file")
+    parser.add_argument("--series", help="the series (SeriesInstanceUID or its end) of a "
+                                         "DICOM folder holding several")
+    parser.add_argument("--scalars", help="the point or cell array of a .vti/.vtk file")
+
+
+def _add_scene(parser):
+    _add_volume(parser)
     parser.add_argument("--filter", default="catmull-rom",
                         help="reconstruction filter (default catmull-rom)")
-    parser.add_argument("--transfer", default="glow:1",
-                        help="glow[:K] or ramp:THRESHOLD:SCALE (default glow:1)")
+    parser.add_argument("--transfer", help=TRANSFER_HELP)
+    parser.add_argument("--cmap", help="a matplotlib colormap name (bone, viridis, ...)")
+    parser.add_argument("--opacity", help="opacity points X:ALPHA,... with X a fraction of "
+                        "the colour limits and ALPHA the opacity per voxel (e.g. "
+                        "0:0,0.3:0,1:0.8); without it, an automatic ramp")
+    parser.add_argument("--clim", help="LOW,HIGH: the data values of the colormap's ends "
+                        "(default the volume's value range)")
     parser.add_argument("--shade", action="store_true", help="Phong shading (gradients)")
     parser.add_argument("--azimuth", type=float, default=30.0)
     parser.add_argument("--elevation", type=float, default=20.0)
@@ -141,15 +212,20 @@ def _add_scene(parser):
     parser.add_argument("--step", type=float, default=0.5, help="ray step in voxels")
 
 
+def _load(args):
+    return load_volume(args.volume, shape=args.shape, dtype=args.dtype, offset=args.offset,
+                       frame=args.frame, series=args.series, scalars=args.scalars)
+
+
 def cmd_render(args):
     import vrlib
     from vrlib.cost import measure
 
     if Path(args.output).suffix.lower() not in (".png", ".npy"):
         raise UsageError(f"output must end in .png or .npy, got {args.output!r}")
-    volume, _ = load_volume(args.volume, shape=args.shape, dtype=args.dtype)
+    volume, field = _load(args)
     view = make_view(args, volume)
-    transfer = make_transfer(args.transfer, args.shade)(volume)
+    transfer = make_transfer(args, field)(volume)
     if args.classified:
         if view.is_perspective:
             raise UsageError("--classified renders orthographic views only (as VolPack)")
@@ -183,9 +259,9 @@ def cmd_compare(args):
     from vrlib.atomic import atomic_path
     from vrlib.cost import measure
 
-    volume, field = load_volume(args.volume, shape=args.shape, dtype=args.dtype)
+    volume, field = _load(args)
     view = make_view(args, volume)
-    transfer = make_transfer(args.transfer, args.shade)(volume)
+    transfer = make_transfer(args, field)(volume)
     reference, label = vrlib.reference_image(volume, view, transfer=transfer, field=field)
     label += " (exact field)" if field is not None else ", Catmull-Rom (no exact field for a file)"
     rows, images = [], {}
@@ -252,10 +328,44 @@ def cmd_bench(args):
         print(f"{method:<10} {filt:<12} {seconds:8.4f} {rmse:10.2e}")
 
 
+def describe_volume(volume):
+    """Lines describing a volume for choosing a transfer function: shape, spacing, box, value
+    range, percentiles and a text histogram."""
+    import vrlib
+
+    data = volume.data.ravel()
+    low, high = volume.value_range
+    ext = " x ".join(f"[{a:g}, {b:g}]" for a, b in volume.extent)
+    lines = [f"shape (z, y, x): {volume.shape}, stored as {volume.dtype}",
+             f"spacing (x, y, z): {', '.join(f'{v:g}' for v in volume.spacing)}",
+             f"world box: {ext}",
+             f"values: {low:g} .. {high:g}"]
+    percent = (1, 5, 25, 50, 75, 95, 99)
+    values = np.percentile(data, percent)
+    lines.append("percentiles: " + ", ".join(f"{p}%: {v:.4g}" for p, v in zip(percent, values,
+                                                                            strict=True)))
+    if high > low:
+        counts, edges = np.histogram(data, bins=16, range=(low, high))
+        width = 40 / max(1.0, np.log1p(counts.max()))
+        lines.append("histogram (16 bins, bar length ~ log count):")
+        for count, start in zip(counts, edges[:-1], strict=True):
+            lines.append(f"  {start:>11.4g} {count:>10d} {'#' * int(np.log1p(count) * width)}")
+        auto = vrlib.auto_transfer(volume)
+        lines.append(f"--transfer auto ramps opacity over {auto.value_range[0]:.4g} .. "
+                     f"{auto.value_range[1]:.4g} (--clim LOW,HIGH --opacity ... to choose)")
+    return lines
+
+
 def cmd_info(args):
     import numba
 
     import vrlib
+
+    if args.volume is not None:
+        volume, field = _load(args)
+        what = f"analytic field {field!r}, sampled" if field is not None else args.volume
+        print("\n".join([what] + describe_volume(volume)))
+        return
 
     lines = [f"vrlib {vrlib.__version__}",
              f"python {platform.python_version()} on {platform.platform()}",
@@ -306,7 +416,10 @@ def parser():
     bench.add_argument("--size", type=int, default=128)
     bench.add_argument("--repeats", type=int, default=3)
     bench.set_defaults(run=cmd_bench)
-    info = sub.add_parser("info", help="machine, backends and versions")
+    info = sub.add_parser("info", help="a volume's shape, spacing and values (to choose a "
+                                       "transfer function); without one, the machine, "
+                                       "backends and versions")
+    _add_volume(info, optional=True)
     info.set_defaults(run=cmd_info)
     return top
 

@@ -124,6 +124,29 @@ class Image:
         bg = validate.vector3("background", background)
         return self.rgba[..., :3] + (1.0 - self.rgba[..., 3:4]) * bg
 
+    def to_png(self, *, bits=8, background=(0.0, 0.0, 0.0)):
+        """The image as PNG bytes (composited over ``background``, or RGBA with straight
+        alpha when it is None), as :meth:`save` writes them.
+
+        Examples
+        --------
+        >>> Image(np.full((2, 2, 4), 0.25)).to_png()[:4]
+        b'\\x89PNG'
+        """
+        if bits not in (8, 16):
+            raise ValueError(f"bits must be 8 or 16, got {bits!r}")
+        if background is None:
+            pixels = np.concatenate([self.straight_rgb(), self.rgba[..., 3:4]], axis=-1)
+        else:
+            pixels = self.composited(background)
+        top = (1 << bits) - 1
+        dtype = np.uint8 if bits == 8 else np.uint16
+        return encode_png(np.round(np.clip(pixels, 0.0, 1.0) * top).astype(dtype))
+
+    def _repr_png_(self):
+        """Jupyter shows an image as its PNG (over black)."""
+        return self.to_png()
+
     def save(self, path, *, bits=8, background=(0.0, 0.0, 0.0)):
         """Write the image to ``.png`` or ``.npy``, atomically (temporary name, then rename).
 
@@ -153,17 +176,9 @@ class Image:
             with atomic_path(path) as tmp:
                 np.save(tmp, self.rgba)
             return
-        if bits not in (8, 16):
-            raise ValueError(f"bits must be 8 or 16, got {bits!r}")
-        if background is None:
-            pixels = np.concatenate([self.straight_rgb(), self.rgba[..., 3:4]], axis=-1)
-        else:
-            pixels = self.composited(background)
-        top = (1 << bits) - 1
-        dtype = np.uint8 if bits == 8 else np.uint16
-        quantised = np.round(np.clip(pixels, 0.0, 1.0) * top).astype(dtype)
+        data = self.to_png(bits=bits, background=background)
         with atomic_path(path) as tmp:
-            tmp.write_bytes(encode_png(quantised))
+            tmp.write_bytes(data)
 
     def __repr__(self):
         return f"Image(shape={self.shape}, max_alpha={float(self.alpha.max(initial=0.0)):.4g})"

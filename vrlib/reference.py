@@ -25,7 +25,7 @@ import time
 import numpy as np
 
 from vrlib import validate
-from vrlib.arguments import check_transfer, check_view
+from vrlib.arguments import check_transfer, framed_view
 from vrlib.image import Image, RenderStats
 from vrlib.volume import check_extent
 
@@ -139,8 +139,8 @@ def render_reference(field, view, *, transfer=None, tol=1e-6, extent=None, segme
     """
     if not callable(field) or not hasattr(field, "bounds"):
         raise TypeError(f"field must be an analytic data_gen field, got {type(field).__name__}")
-    check_view(view)
     transfer = check_transfer(transfer)
+    view = framed_view(view, field.bounds if extent is None else extent)
     tol = validate.finite_number("tol", tol, low=0.0, low_open=True)
     segments = validate.positive_int("segments", segments)
     chunk = validate.positive_int("chunk", chunk)

@@ -6,7 +6,8 @@ import inspect
 
 from vrlib import validate
 from vrlib._scheduling import thread_count
-from vrlib.arguments import render_arguments
+from vrlib.arguments import framed_view, render_arguments
+from vrlib.colormapping import auto_transfer
 from vrlib.raycast import render_raycast
 from vrlib.reference import render_reference
 from vrlib.shear import render_shear2, render_shear3
@@ -57,7 +58,10 @@ def render(volume, view, *, method="raycast", filter="trilinear", transfer=None,
         filter (``"cardinal-bspline"``, ``"omoms"``) reconstructs spline coefficients with its
         kernel, in every method (:mod:`vrlib.prefilter` says which axes each prefilters; the
         volume's coefficients are kept with it); ``stats.prefilter`` says what it cost.
-    transfer : TransferFunction, default ``Glow(1.0)``
+    transfer : TransferFunction or "auto", default ``Glow(1.0)``
+        ``"auto"`` fits a grey ramp to the volume's histogram (:func:`vrlib.auto_transfer`),
+        for real data; ``Glow(1.0)`` (density = value per world unit) is the thesis's study
+        function for the analytic fields. Build others with :func:`vrlib.colormap`.
     step : float, default 0.5
         Sample spacing along each ray, in voxels (of the smallest spacing); > 0. Opacity is
         computed per segment as ``1 - exp(-density * step)``, so images converge as the step
@@ -99,8 +103,11 @@ def render(volume, view, *, method="raycast", filter="trilinear", transfer=None,
                 if type(volume).__name__ == "ClassifiedVolume" else "")
         raise TypeError(f"volume must be a vrlib.Volume, got {type(volume).__name__}{hint}")
     validate.choice("method", method, tuple(METHODS))
+    if isinstance(transfer, str) and transfer == "auto":
+        transfer = auto_transfer(volume)
     filt, transfer, step, early_termination = render_arguments(view, filter, transfer, step,
                                                                early_termination)
+    view = framed_view(view, volume.extent, transfer, volume.value_range)
     if not isinstance(empty_space_skipping, bool):
         raise TypeError(
             f"empty_space_skipping must be True or False, got {empty_space_skipping!r}"

@@ -7,9 +7,11 @@ The basis is right-handed: ``right x up = -forward`` (the camera looks down its 
 as in OpenGL).
 
 At ``zoom = 1`` the shorter image side spans the diameter of the scene sphere (``center``,
-``radius``; by default the bounding sphere of the cube [-1, 1]^3), so every orbit sees the
-whole volume. Orthographic rays start on the plane tangent to that sphere nearest the viewer;
-perspective rays start at the eye.
+``radius``), so every orbit sees the whole volume. A view given neither ``center`` nor
+``radius`` frames whatever it renders: :func:`vrlib.render` replaces its sphere by the
+volume's bounding sphere (:meth:`View.fitted`), so a volume in its own units (millimetres, a
+grid of 0..499) renders without knowing where it lies. Orthographic rays start on the plane
+tangent to that sphere nearest the viewer; perspective rays start at the eye.
 """
 
 from __future__ import annotations
@@ -57,11 +59,12 @@ class View:
         ``forward``.
     size : int or (int, int), default 256
         Image size in pixels: ``n`` for ``n x n`` or ``(height, width)``.
-    center : array_like of 3 floats, default (0, 0, 0)
+    center : array_like of 3 floats, optional
         The point looked at; the centre of the scene sphere.
-    radius : float, default sqrt(3)
-        Radius of the scene sphere (``sqrt(3)`` bounds [-1, 1]^3; use
-        ``volume.bounding_radius`` for other volumes).
+    radius : float, optional
+        Radius of the scene sphere. Give neither ``center`` nor ``radius`` to frame the volume
+        rendered (its bounding sphere, :meth:`fitted`); until then the view frames the cube
+        [-1, 1]^3 (centre 0, radius ``sqrt(3)``).
     projection : {"orthographic", "perspective"}
     zoom : float, default 1.0
         Magnification (> 0): at 1 the shorter image side spans the sphere's diameter.
@@ -88,9 +91,13 @@ class View:
     0.866025
     """
 
-    def __init__(self, forward, up=(0.0, 0.0, 1.0), *, size=256, center=(0.0, 0.0, 0.0),
-                 radius=_DEFAULT_RADIUS, projection="orthographic", zoom=1.0, fov=None,
-                 distance=None):
+    def __init__(self, forward, up=(0.0, 0.0, 1.0), *, size=256, center=None, radius=None,
+                 projection="orthographic", zoom=1.0, fov=None, distance=None):
+        #: Whether the scene sphere was given (False: :meth:`fitted` frames the volume).
+        self.framed = center is not None or radius is not None
+        self._given = {"up": up, "fov": fov, "distance": distance}
+        center = (0.0, 0.0, 0.0) if center is None else center
+        radius = _DEFAULT_RADIUS if radius is None else radius
         f = validate.vector3("forward", forward, unit=True)
         up = validate.vector3("up", up, unit=True)
         right = np.cross(f, up)
@@ -133,8 +140,7 @@ class View:
 
     @classmethod
     def orbit(cls, *, azimuth=0.0, elevation=0.0, size=256, projection="orthographic",
-              zoom=1.0, fov=None, distance=None, center=(0.0, 0.0, 0.0),
-              radius=_DEFAULT_RADIUS):
+              zoom=1.0, fov=None, distance=None, center=None, radius=None):
         """A view from a point on a sphere around ``center``, world z up.
 
         The eye lies in direction ``(cos e cos a, cos e sin a, sin e)`` from the centre
@@ -157,6 +163,65 @@ class View:
         up = np.cross(right, -eye_dir)
         return cls(-eye_dir, up, size=size, center=center, radius=radius,
                    projection=projection, zoom=zoom, fov=fov, distance=distance)
+
+    @classmethod
+    def fit(cls, volume, **orbit):
+        """An orbit view (:meth:`orbit`'s keywords) framing ``volume``'s bounding sphere.
+
+        Examples
+        --------
+        >>> from vrlib import Volume
+        >>> vol = Volume(np.zeros((2, 2, 2)), spacing=(499, 469, 135))
+        >>> view = View.fit(vol, azimuth=30, size=8)
+        >>> view.center.tolist(), round(view.radius, 1)
+        ([249.5, 234.5, 67.5], 349.0)
+        """
+        box = extent_of(volume)
+        return cls.orbit(center=box.mean(axis=1), radius=_radius_of(box), **orbit)
+
+    def fitted(self, volume):
+        """This view framing ``volume`` (a :class:`vrlib.Volume`, a field or a world box
+        ``(3, 2)``), unless it was given its own ``center`` or ``radius``: then itself.
+
+        :func:`vrlib.render` and the other renderers' entry points call it, so a view built
+        from angles alone sees the whole volume, in any units.
+
+        Examples
+        --------
+        >>> box = [[0, 499], [0, 469], [0, 135]]
+        >>> View.orbit(azimuth=30, size=8).fitted(box).center.tolist()
+        [249.5, 234.5, 67.5]
+        >>> View.orbit(size=8, radius=1.0).fitted(box).center.tolist()   # framed by the user
+        [0.0, 0.0, 0.0]
+        """
+        if self.framed:
+            return self
+        box = extent_of(volume)
+        return View(self.forward, self._given["up"], size=self.shape, center=box.mean(axis=1),
+                    radius=_radius_of(box), projection=self.projection, zoom=self.zoom,
+                    fov=self._given["fov"], distance=self._given["distance"])
+
+    def sees(self, extent):
+        """Whether any part of the world box ``extent`` projects into the image.
+
+        Examples
+        --------
+        >>> view = View.orbit(size=8, radius=1.0)
+        >>> view.sees([[-1, 1], [-1, 1], [-1, 1]]), view.sees([[0, 1], [50, 60], [0, 1]])
+        (True, False)
+        """
+        box = np.asarray(extent, dtype=np.float64)
+        corners = np.array([[box[0, i], box[1, j], box[2, k]]
+                            for i in (0, 1) for j in (0, 1) for k in (0, 1)])
+        if self.is_perspective:
+            depth = self.to_camera(corners)[:, 2]
+            if np.all(depth <= 0.0):
+                return False
+            if np.any(depth <= 0.0):
+                return True  # the eye is inside or beside the box: it may fill the view
+        rows, cols = self.project(corners)[:, :2].T
+        return bool(rows.min() < self.height and rows.max() > 0.0
+                    and cols.min() < self.width and cols.max() > 0.0)
 
     # -- geometry --------------------------------------------------------------------------
 
@@ -323,6 +388,21 @@ class View:
             f"View(forward=[{f}], size=({self.height}, {self.width}), "
             f"projection={self.projection!r}, zoom={self.zoom:g}{extra})"
         )
+
+
+def extent_of(scene):
+    """The world box of a volume, a field (its ``bounds``) or a ``(3, 2)`` array."""
+    for name in ("extent", "bounds"):
+        if hasattr(scene, name):
+            return np.asarray(getattr(scene, name), dtype=np.float64)
+    box = np.asarray(scene, dtype=np.float64)
+    if box.shape != (3, 2):
+        raise ValueError(f"a view frames a Volume, a field or a (3, 2) world box, got {scene!r}")
+    return box
+
+
+def _radius_of(box):
+    return float(0.5 * np.linalg.norm(box[:, 1] - box[:, 0]))
 
 
 def principal_axis(view, volume):

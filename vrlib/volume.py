@@ -14,7 +14,8 @@ from scipy import ndimage
 
 from vrlib import validate
 
-__all__ = ["Volume", "MinMaxPyramid", "DEFAULT_EXTENT", "check_extent", "storage_dtype"]
+__all__ = ["Volume", "MinMaxPyramid", "DEFAULT_EXTENT", "check_extent", "fitted_extent",
+           "storage_dtype"]
 
 #: The default world box, ``[[xmin, xmax], [ymin, ymax], [zmin, zmax]]``: the cube [-1, 1]^3.
 DEFAULT_EXTENT = ((-1.0, 1.0), (-1.0, 1.0), (-1.0, 1.0))
@@ -90,17 +91,31 @@ class Volume:
         Real, finite samples; every dimension at least 2. Types that float32 holds exactly
         (8- and 16-bit integers, float16, float32) are stored as float32, all others as float64.
     extent : array_like, shape (3, 2), optional
-        World box ``[[xmin, xmax], [ymin, ymax], [zmin, zmax]]``; default the cube [-1, 1]^3.
-        Samples lie on its corners and evenly between them.
+        World box ``[[xmin, xmax], [ymin, ymax], [zmin, zmax]]``. Samples lie on its corners
+        and evenly between them.
+    spacing : array_like of 3 floats, optional
+        World distance between neighbouring samples along ``(x, y, z)`` (> 0), as pyvista's
+        ``ImageData`` takes it; default 1 when only ``origin`` is given.
+    origin : array_like of 3 floats, optional
+        World position of sample ``data[0, 0, 0]``; default ``(0, 0, 0)`` when only
+        ``spacing`` is given.
     copy : bool, default True
         Copy ``data``. With ``copy=False`` an array that already has the storage type is used
         as is (read-only view): do not modify it afterwards.
 
+    Notes
+    -----
+    With neither ``extent`` nor ``spacing``/``origin`` the voxels are cubes and the box is
+    centred on the origin with its longest side spanning [-1, 1] (:func:`fitted_extent`): a
+    cubic array fills the cube [-1, 1]^3, and a ``(10, 20, 40)`` array is not stretched to it.
+    Pass ``extent=DEFAULT_EXTENT`` to stretch any array over the cube.
+
     Raises
     ------
     ValueError
-        Non-finite samples, not exactly 3 dimensions, a dimension below 2, or an extent that is
-        empty, inverted or non-finite.
+        Non-finite samples, not exactly 3 dimensions, a dimension below 2, an extent that is
+        empty, inverted or non-finite, a spacing that is not positive, or ``extent`` together
+        with ``spacing``/``origin``.
     TypeError
         A non-numeric (or boolean, or complex) dtype.
 
@@ -110,13 +125,15 @@ class Volume:
     >>> vol = Volume(np.zeros((3, 4, 5)))
     >>> vol.shape
     (3, 4, 5)
-    >>> vol.spacing.tolist()          # (dx, dy, dz) in world units
-    [0.5, 0.6666666666666666, 1.0]
+    >>> vol.spacing.tolist()          # (dx, dy, dz): cubic voxels, longest side [-1, 1]
+    [0.5, 0.5, 0.5]
     >>> vol.index_to_world([4, 3, 2]).tolist()
-    [1.0, 1.0, 1.0]
+    [1.0, 0.75, 0.5]
+    >>> Volume(np.zeros((3, 4, 5)), spacing=(1, 1, 2.5)).extent.tolist()
+    [[0.0, 4.0], [0.0, 3.0], [0.0, 5.0]]
     """
 
-    def __init__(self, data, extent=None, *, copy=True):
+    def __init__(self, data, extent=None, *, spacing=None, origin=None, copy=True):
         arr = np.asarray(data)
         if arr.dtype.kind not in "iuf":
             raise TypeError(
@@ -141,7 +158,7 @@ class Volume:
             arr = arr.view()
         arr.flags.writeable = False
         self._data = arr
-        self._extent = check_extent(DEFAULT_EXTENT if extent is None else extent)
+        self._extent = _world_box(arr.shape, extent, spacing, origin)
         self._derived = {}  # cached structures built from the samples (pyramids, runs)
         self._range = None
 
@@ -381,6 +398,37 @@ class Volume:
     def __repr__(self):
         ext = ", ".join(f"[{lo:g}, {hi:g}]" for lo, hi in self._extent)
         return f"Volume(shape={self.shape}, dtype={self.dtype}, extent=[{ext}])"
+
+
+def fitted_extent(shape, spacing=(1.0, 1.0, 1.0)):
+    """World box for a ``(nz, ny, nx)`` lattice of ``(dx, dy, dz)`` spacing, centred on the
+    origin with its longest side spanning [-1, 1].
+
+    Examples
+    --------
+    >>> fitted_extent((2, 3, 5)).tolist()
+    [[-1.0, 1.0], [-0.5, 0.5], [-0.25, 0.25]]
+    """
+    sizes = (np.array(shape[::-1], dtype=np.float64) - 1.0) * np.asarray(spacing, dtype=float)
+    half = sizes / sizes.max()
+    return np.stack([-half, half], axis=1)
+
+
+def _world_box(shape, extent, spacing, origin):
+    """The checked world box from ``extent``, or ``spacing`` and ``origin``, or the default."""
+    if extent is not None:
+        if spacing is not None or origin is not None:
+            raise ValueError("give the world box either as extent or as spacing and origin, "
+                             "not both")
+        return check_extent(extent)
+    if spacing is None and origin is None:
+        return check_extent(fitted_extent(shape))
+    step = np.ones(3) if spacing is None else validate.vector3("spacing", spacing)
+    if np.any(step <= 0.0):
+        raise ValueError(f"spacing must be positive along x, y and z, got {step.tolist()}")
+    start = np.zeros(3) if origin is None else validate.vector3("origin", origin)
+    sizes = (np.array(shape[::-1], dtype=np.float64) - 1.0) * step
+    return check_extent(np.stack([start, start + sizes], axis=1))
 
 
 def check_extent(extent):

@@ -149,14 +149,18 @@ def measure_memory():
                                                          extent=field.bounds)
         array.flush()
         del array
-        report = launch(MEMORY["ranks"], {**RAMP, "file": str(path), "size": MEMORY["size"],
+        # The file is in voxel units (as data_gen.load reads a .npy), the field spans 2: the
+        # same optical depth needs the density per voxel.
+        per_voxel = {**RAMP, "scale": RAMP["scale"] * 2.0 / (n - 1)}
+        report = launch(MEMORY["ranks"], {**per_voxel, "file": str(path), "size": MEMORY["size"],
                                           "orbits": [ORBIT], "memory": True,
                                           "cases": [["radix-k", "even"]],
                                           "save": str(Path(folder) / "frame.npy")})
         frame = np.load(Path(folder) / "frame.npy")
         volume = data_gen.load(path)
         view = View.orbit(size=MEMORY["size"], **ORBIT)
-        serial = vrlib.render(volume, view, transfer=ramp(RAMP["threshold"], RAMP["scale"]),
+        serial = vrlib.render(volume, view, transfer=ramp(per_voxel["threshold"],
+                                                          per_voxel["scale"]),
                               early_termination=1.0)
         size_bytes = volume.data.nbytes
         del volume

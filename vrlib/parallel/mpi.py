@@ -191,6 +191,7 @@ def render_object(comm, source, view, *, shape=None, extent=None, filter="trilin
                                                   balance, bricks_per_rank)
         root = _root(root, size)
         lattice, read = open_source(source, shape, extent)
+        view = view.fitted(lattice.extent)
         if balance == "interleaved":
             tree = split(lattice.cells, size * bricks_per_rank)
         else:
@@ -302,6 +303,7 @@ def render_image(comm, source, view, *, shape=None, extent=None, filter="triline
         validate.choice("layout", layout, ("contiguous", "interleaved"))
         root = _root(root, size)
         lattice, read = open_source(source, shape, extent)
+        view = view.fitted(lattice.extent)
         tree = split(lattice.cells, size)
         tiles = screen_tiles(view.height, view.width, size, layout=layout, tile=tile)
     ds = step * float(lattice.spacing.min())

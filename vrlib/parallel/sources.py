@@ -4,8 +4,8 @@ A source is an analytic field (each rank evaluates its brick and ghost samples,
 :meth:`data_gen.Field.sample_region`) or a file, memory-mapped so that each rank reads only
 the pages of its brick: ``.npy``, uncompressed NIfTI (``.nii``) or headerless samples
 (:class:`RawFile`). Either way the ranks share one global sample lattice (:class:`Lattice`),
-so bricks render on the same ray lattice and join without seams. A file's world box is
-:func:`data_gen.fitted_extent` of its shape (and voxel sizes), as the serial loaders give it.
+so bricks render on the same ray lattice and join without seams. A file's world box is the
+one :func:`data_gen.load` gives it (voxel units, or the NIfTI affine's RAS+ box).
 Samples of 8- and 16-bit integers, float16 and float32 are read as float32, others as
 float64, as :class:`vrlib.Volume` stores them, so a brick holds no more than its share.
 """
@@ -39,6 +39,11 @@ class Lattice:
     def cells(self):
         return tuple(n - 1 for n in self.shape)
 
+    @property
+    def extent(self):
+        """World box ``[[xmin, xmax], [ymin, ymax], [zmin, zmax]]`` of the whole lattice."""
+        return np.stack(self.box((0, 0, 0), self.cells), axis=1)
+
     def box(self, lo, hi):
         """World box (x, y, z arrays) of cells ``[lo, hi)``."""
         return (self.origin + np.array(lo[::-1]) * self.spacing,
@@ -57,7 +62,7 @@ class RawFile:
     >>> np.arange(27, dtype=np.uint8).tofile(f)
     >>> array, extent, scaling = memory_map(RawFile(f, (3, 3, 3), "uint8"))
     >>> int(array[2, 1, 0]), extent.tolist()[0]
-    (21, [-1.0, 1.0])
+    (21, [0.0, 2.0])
     """
 
     path: str | Path
@@ -74,8 +79,6 @@ def memory_map(source):
     Raises ValueError naming the problem for a missing, truncated or unreadable file, a
     compressed NIfTI (which cannot be mapped) or an array that is not 3-D.
     """
-    from data_gen import fitted_extent
-
     if isinstance(source, RawFile):
         path = _file(source.path)
         shape = tuple(validate.positive_int("shape", n, minimum=2) for n in source.shape)
@@ -87,7 +90,7 @@ def memory_map(source):
         offset = validate.positive_int("offset", source.offset, minimum=0)
         _check_size(path, offset + math.prod(shape) * dtype.itemsize, shape, dtype, offset)
         array = np.memmap(path, dtype=dtype, mode="r", offset=offset, shape=shape)
-        return array, fitted_extent(shape), None
+        return array, _voxel_box(shape), None
     path = _file(source)
     name = path.name.lower()
     if name.endswith(".npy"):
@@ -97,14 +100,19 @@ def memory_map(source):
             raise ValueError(f"source {path.name} is not a readable .npy file: {error}") \
                 from None
         _check_3d(path, array.shape)
-        return array, fitted_extent(array.shape), None
+        return array, _voxel_box(array.shape), None
     if name.endswith(".nii"):
-        return _map_nifti(path, fitted_extent)
+        return _map_nifti(path)
     if name.endswith(".nii.gz"):
         raise ValueError(f"source {path.name} is compressed, and each rank must read only its "
                          "brick from the file: decompress it (gunzip) to a .nii file")
     raise ValueError(f"source {path.name} is not a format a rank can read its brick from: use "
                      ".npy, .nii or vrlib.parallel.sources.RawFile(path, shape, dtype)")
+
+
+def _voxel_box(shape):
+    """The world box of a file without a header: one unit per voxel from the origin."""
+    return np.stack([np.zeros(3), np.array(shape[::-1], dtype=np.float64) - 1.0], axis=1)
 
 
 def _file(path):
@@ -129,17 +137,21 @@ def _check_3d(path, shape):
                          f"per axis, got shape {tuple(shape)}")
 
 
-def _map_nifti(path, fitted_extent):
-    """An uncompressed NIfTI file's voxels (i fastest on disk: ``[k, j, i]`` = ``[z, y, x]``,
-    as :func:`data_gen.load_nifti` orders them)."""
+def _map_nifti(path):
+    """An uncompressed NIfTI file's voxels, turned to RAS+ as :func:`data_gen.load_nifti`
+    turns them (flips and axis swaps are views of the mapping: nothing is read)."""
     import nibabel
+    from nibabel import orientations
+
+    from data_gen.loaders import nifti_orientation
 
     try:
         image = nibabel.load(path)
-        proxy, header = image.dataobj, image.header
+        proxy = image.dataobj
         dtype, offset = np.dtype(proxy.dtype), int(proxy.offset)
         shape = tuple(int(n) for n in proxy.shape)
         slope, intercept = float(proxy.slope), float(proxy.inter)
+        ornt, spacing, origin = nifti_orientation(image)
     except Exception as error:  # nibabel raises many kinds on a corrupt header
         raise ValueError(f"source {path.name} is not a readable NIfTI file: {error}") from None
     if len(shape) == 4 and shape[3] == 1:
@@ -147,9 +159,10 @@ def _map_nifti(path, fitted_extent):
     _check_3d(path, shape)
     _check_size(path, offset + math.prod(shape) * dtype.itemsize, shape, dtype, offset)
     array = np.memmap(path, dtype=dtype, mode="r", offset=offset, shape=shape[::-1])
+    array = orientations.apply_orientation(array.T, ornt).T  # [z, y, x] of the RAS+ axes
     scaling = None if (slope, intercept) == (1.0, 0.0) else (slope, intercept)
-    spacing = np.asarray(header.get_zooms()[:3], dtype=np.float64)
-    return array, fitted_extent(array.shape, spacing), scaling
+    sizes = (np.array(array.shape[::-1], dtype=np.float64) - 1.0) * spacing
+    return array, np.stack([origin, origin + sizes], axis=1), scaling
 
 
 def open_source(source, shape, extent):
