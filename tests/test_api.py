@@ -15,7 +15,8 @@ MODULES = [
     "vrlib.image", "vrlib.metrics", "vrlib.bounds", "vrlib.cost", "data_gen", "data_gen.fields",
     "data_gen.loaders", "vrlib.parallel.taxonomy", "vrlib.parallel.decompose",
     "vrlib.parallel.model", "vrlib.parallel.network", "vrlib.parallel.traffic",
-    "vrlib.parallel.mpi", "vrlib.colormapping", "data_gen.datasets",
+    "vrlib.parallel.mpi", "vrlib.colormapping", "vrlib.projection", "vrlib.animation",
+    "data_gen.datasets",
     "data_gen.dicom",
 ]
 # Abstract bases: their subclasses carry the examples.

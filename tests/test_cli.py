@@ -146,6 +146,26 @@ def test_real_volumes_render_by_name_with_their_transfer_functions(tmp_path):
     assert "spacing (x, y, z): 4, 4, 5" in done.stdout and "histogram" in done.stdout
 
 
+def test_labels_projections_and_turntables(tmp_path):
+    """The frog's labels (nearest-sample filter by default), a maximum-intensity projection,
+    and turntables as GIF and MP4."""
+    done = run("render", "frog", "--labels", "--size", "24", "-o", str(tmp_path / "f.npy"))
+    assert done.returncode == 0 and "raycast/box" in done.stdout, done.stderr
+    rgba = np.load(tmp_path / "f.npy")
+    assert rgba[..., 3].max() > 0.3 and np.ptp(rgba[..., :3].max(axis=(0, 1))) > 0.05  # colour
+    done = run("render", "aniso", "--blend", "maximum", "--cmap", "gray", "--opacity",
+               "0:1,1:1", "--size", "16", "-o", str(tmp_path / "mip.npy"))
+    assert done.returncode == 0 and "maximum intensity projection" in done.stdout, done.stderr
+    assert np.load(tmp_path / "mip.npy")[..., 3].max() > 0.9999
+    for name, magic in (("spin.gif", b"GIF8"), ("spin.mp4", b"ftyp")):
+        done = run("turntable", "gaussian-blob:12:sigma=0.3", "--frames", "3", "--size", "32",
+                   "-o", str(tmp_path / name))
+        assert done.returncode == 0 and "3 frames" in done.stdout, done.stderr
+        assert magic in (tmp_path / name).read_bytes()[:12]
+    done = run("turntable", "gaussian-blob:12", "-o", str(tmp_path / "spin.avi"))
+    assert done.returncode == 2 and "output must end in .gif or .mp4" in done.stderr
+
+
 def test_render_a_dicom_folder(tmp_path):
     from data_gen.dicom import write_series
 

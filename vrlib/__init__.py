@@ -18,9 +18,10 @@ The public API is the list in ``__all__``.
 """
 
 from vrlib import bounds, compositing, cost, filters, metrics, prefilter
+from vrlib.animation import turntable
 from vrlib.arguments import EmptyImageWarning
 from vrlib.classified import ClassifiedVolume, classify
-from vrlib.colormapping import auto_transfer, colormap
+from vrlib.colormapping import auto_transfer, colormap, label_transfer
 from vrlib.filters import FILTERS, make_filter
 from vrlib.image import Image, RenderStats
 from vrlib.reconstruction import reconstruct
@@ -35,6 +36,7 @@ __version__ = "0.1.0"
 __all__ = [
     "render",
     "render_reference",
+    "turntable",
     "reconstruct",
     "reference_image",
     "METHODS",
@@ -46,6 +48,7 @@ __all__ = [
     "LookupTransfer",
     "colormap",
     "auto_transfer",
+    "label_transfer",
     "Phong",
     "GradientOpacity",
     "TransferFunction",

@@ -1,4 +1,5 @@
-"""The command line: ``vrlib render | compare | bench | info`` (also ``python -m vrlib``).
+"""The command line: ``vrlib render | turntable | compare | bench | info`` (also
+``python -m vrlib``).
 
 Bad input ends with exit status 2 and a one-line message naming what was wrong.
 """
@@ -20,6 +21,9 @@ EXAMPLES = """examples:
   vrlib render frog --cmap bone --opacity 0:0,0.2:0,1:0.6 --clim 0,29 --shade -o frog.png
   vrlib render scan.raw --shape 64,64,64 --dtype uint8 --offset 512 -o scan.png
   vrlib render dicom_folder/ --cmap gray -o ct.png
+  vrlib render aniso --blend maximum --cmap gray --opacity 0:1,1:1 -o mip.png
+  vrlib render frog --labels --shade --zoom 1.5 -o frog_labels.png
+  vrlib turntable mni152 --cmap bone --shade --frames 36 -o head.gif
   vrlib info aniso
   vrlib compare marschner-lobb:41 --size 128 -o compare.png
   vrlib bench
@@ -113,6 +117,12 @@ def make_transfer(args, field):
     import vrlib
 
     shading = vrlib.Phong() if args.shade else None
+    if args.labels:
+        if args.transfer is not None or args.opacity is not None or args.clim is not None:
+            raise UsageError("--labels gives every label its own colour: it takes --cmap and "
+                             "--shade, not --transfer, --opacity or --clim")
+        return lambda volume: vrlib.label_transfer(volume, cmap=args.cmap or "tab20",
+                                                   shading=shading)
     if args.cmap is not None or args.opacity is not None:
         if args.transfer is not None:
             raise UsageError("give either --transfer or --cmap/--opacity, not both")
@@ -193,8 +203,8 @@ def _add_volume(parser, optional=False):
 
 def _add_scene(parser):
     _add_volume(parser)
-    parser.add_argument("--filter", default="catmull-rom",
-                        help="reconstruction filter (default catmull-rom)")
+    parser.add_argument("--filter", help="reconstruction filter (default catmull-rom; box "
+                                         "with --labels)")
     parser.add_argument("--transfer", help=TRANSFER_HELP)
     parser.add_argument("--cmap", help="a matplotlib colormap name (bone, viridis, ...)")
     parser.add_argument("--opacity", help="opacity points X:ALPHA,... with X a fraction of "
@@ -202,6 +212,9 @@ def _add_scene(parser):
                         "0:0,0.3:0,1:0.8); without it, an automatic ramp")
     parser.add_argument("--clim", help="LOW,HIGH: the data values of the colormap's ends "
                         "(default the volume's value range)")
+    parser.add_argument("--labels", action="store_true",
+                        help="a label volume: one colour per label (--cmap, default tab20), "
+                             "label 0 transparent, nearest-sample filter")
     parser.add_argument("--shade", action="store_true", help="Phong shading (gradients)")
     parser.add_argument("--azimuth", type=float, default=30.0)
     parser.add_argument("--elevation", type=float, default=20.0)
@@ -210,6 +223,13 @@ def _add_scene(parser):
                         choices=["orthographic", "perspective"])
     parser.add_argument("--zoom", type=float, default=1.0)
     parser.add_argument("--step", type=float, default=0.5, help="ray step in voxels")
+
+
+def _filter(args):
+    """The filter asked for: catmull-rom by default, the nearest sample for labels."""
+    if args.filter is not None:
+        return args.filter
+    return "box" if args.labels else "catmull-rom"
 
 
 def _load(args):
@@ -234,11 +254,28 @@ def cmd_render(args):
         what = f"classified shear-warp (classified in {scene.seconds:.3f} s)"
     else:
         seconds, img = measure(partial(
-            vrlib.render, volume, view, method=args.method, filter=args.filter,
-            transfer=transfer, step=args.step), repeats=1, warmup=False)
-        what = f"{args.method}/{args.filter}"
+            vrlib.render, volume, view, method=args.method, filter=_filter(args),
+            transfer=transfer, step=args.step, blend=args.blend), repeats=1, warmup=False)
+        what = f"{args.method}/{_filter(args)}"
+        if args.blend != "emission-absorption":
+            what += f", {args.blend} intensity projection"
     img.save(args.output, bits=args.bits)
     print(f"{args.output}: {view.width}x{view.height} {what} in {seconds:.3f} s")
+
+
+def cmd_turntable(args):
+    import vrlib
+
+    if Path(args.output).suffix.lower() not in (".gif", ".mp4"):
+        raise UsageError(f"output must end in .gif or .mp4, got {args.output!r}")
+    volume, field = _load(args)
+    transfer = make_transfer(args, field)(volume)
+    images = vrlib.turntable(volume, args.output, frames=args.frames, elevation=args.elevation,
+                             size=args.size, zoom=args.zoom, fps=args.fps, method=args.method,
+                             filter=_filter(args), transfer=transfer, step=args.step)
+    seconds = sum(image.stats.seconds for image in images)
+    print(f"{args.output}: {len(images)} frames of {args.size}x{args.size}, rendered in "
+          f"{seconds:.2f} s")
 
 
 def _errors(img, ref):
@@ -268,7 +305,7 @@ def cmd_compare(args):
     for method in tqdm(vrlib.METHODS, desc="methods", file=sys.stderr, disable=None):
         try:
             seconds, img = measure(partial(vrlib.render, volume, view, method=method,
-                                           filter=args.filter, transfer=transfer,
+                                           filter=_filter(args), transfer=transfer,
                                            step=args.step), repeats=1, warmup=False)
         except ValueError as error:
             rows.append((method, None, None, None, str(error)))
@@ -276,7 +313,7 @@ def cmd_compare(args):
         images[method] = img
         err = _errors(img, reference)
         rows.append((method, seconds, err["rmse"], err["max"], ""))
-    print(f"errors against the {label}; filter {args.filter}, {view.width}x{view.height}")
+    print(f"errors against the {label}; filter {_filter(args)}, {view.width}x{view.height}")
     print(f"{'method':<10} {'seconds':>8} {'rmse':>10} {'max':>10}")
     for method, seconds, rmse, worst, note in rows:
         if seconds is None:
@@ -399,12 +436,25 @@ def parser():
     _add_scene(render)
     render.add_argument("--method", default="raycast",
                         help="raycast, splat, shear3, shear2 or shearwarp (default raycast)")
+    render.add_argument("--blend", default="emission-absorption",
+                        choices=["emission-absorption", "maximum", "average"],
+                        help="composite the samples (default), or project the largest "
+                             "(maximum intensity) or mean value along each ray (ray casting)")
     render.add_argument("--classified", action="store_true",
                         help="classify once and render by shear-warp as VolPack does (takes "
                              "--shade; --method, --filter and --step do not apply)")
     render.add_argument("--bits", type=int, default=8, choices=[8, 16], help="PNG bit depth")
     render.add_argument("-o", "--output", required=True, help="output .png or .npy")
     render.set_defaults(run=cmd_render)
+    spin = sub.add_parser("turntable", help="views around the volume as a .gif or .mp4",
+                          epilog=EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
+    _add_scene(spin)
+    spin.add_argument("--method", default="raycast",
+                      help="raycast, splat, shear3, shear2 or shearwarp (default raycast)")
+    spin.add_argument("--frames", type=int, default=36, help="views around the turntable")
+    spin.add_argument("--fps", type=float, default=12.0, help="frames per second")
+    spin.add_argument("-o", "--output", required=True, help="output .gif or .mp4")
+    spin.set_defaults(run=cmd_turntable)
     compare = sub.add_parser("compare", help="every method on one volume, with errors",
                              epilog=EXAMPLES,
                              formatter_class=argparse.RawDescriptionHelpFormatter)

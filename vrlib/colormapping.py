@@ -1,5 +1,6 @@
 """Transfer functions the way ParaView, VTK and napari users build them: a named colormap with a
-piecewise-linear opacity given as points, and a default fitted to the volume's histogram.
+piecewise-linear opacity given as points, a default fitted to the volume's histogram, and one
+colour and opacity per label of a label volume.
 
 Opacity points are ``(x, alpha)`` pairs: ``x`` a fraction of the colour limits ``clim``
 (0 at ``clim[0]``, 1 at ``clim[1]``), ``alpha`` the opacity of a slab ``unit_distance`` thick
@@ -16,7 +17,7 @@ import numpy as np
 from vrlib import validate
 from vrlib.transfer import LookupTransfer
 
-__all__ = ["colormap", "auto_transfer", "parse_opacity", "MAX_ALPHA"]
+__all__ = ["colormap", "auto_transfer", "label_transfer", "parse_opacity", "MAX_ALPHA"]
 
 #: Opacity points are capped below 1 (infinite density) at this value.
 MAX_ALPHA = 1.0 - 1e-6
@@ -180,3 +181,82 @@ def auto_transfer(volume, cmap="gray", *, shading=None, peak_alpha=0.25):
         top = high
     return colormap(cmap, [(0.0, 0.0), (1.0, peak)], clim=(threshold, top), volume=volume,
                     shading=shading)
+
+
+def label_transfer(volume, *, colors=None, opacity=0.3, hidden=(0,), cmap="tab20",
+                   unit_distance=None, shading=None):
+    """One colour and one opacity per label of an integer label volume (segmentations, the
+    frog's tissues).
+
+    The table holds each label's colour and opacity unchanged over ``[label - 1/4,
+    label + 1/4]``, so a sample that reconstructs to exactly its label gets exactly its
+    label's classification. Render with ``filter="box"`` (nearest sample, as VTK's nearest
+    interpolation of labels): any other filter blends neighbouring labels' numbers, and a
+    boundary between labels 3 and 5 would pass through label 4's colour.
+
+    Parameters
+    ----------
+    volume : Volume
+        Integer values (stored as floats).
+    colors : dict, optional
+        ``{label: colour}`` (a matplotlib colour name or RGB triple) overriding ``cmap``.
+    opacity : float or dict, default 0.3
+        Opacity per ``unit_distance`` of every shown label, or ``{label: alpha}`` (labels
+        missing from the dict get 0.3).
+    hidden : iterable of int, default (0,)
+        Labels drawn fully transparent (the background).
+    cmap : str, default "tab20"
+        Qualitative colormap giving label ``i`` (the i-th label present) its colour.
+    unit_distance : float, optional
+        As :func:`colormap` (default the smallest voxel spacing).
+
+    Examples
+    --------
+    >>> from vrlib import Volume
+    >>> labels = Volume(np.array([0, 1, 2, 5] * 2, float).reshape(2, 2, 2))
+    >>> tf = label_transfer(labels, colors={2: "red"}, opacity={5: 0.9})
+    >>> tf.emission(np.array([2.0]))[0].tolist(), float(tf.opacity_density([0.0])[0])
+    ([1.0, 0.0, 0.0], 0.0)
+    """
+    import matplotlib.colors
+
+    values = np.unique(volume.data)
+    if values.size > 4096 or not np.all(values == np.round(values)):
+        raise ValueError("a label volume holds integer labels (at most 4096 of them); this one "
+                         f"holds {values.size} values, e.g. {values[:3].tolist()}: use "
+                         "colormap() or auto_transfer() for measurements")
+    labels = values.astype(np.int64)
+    colors = dict(colors or {})
+    unknown = sorted(set(colors) - set(labels.tolist()))
+    if unknown:
+        raise ValueError(f"colors names label(s) {unknown} that the volume does not hold; its "
+                         f"labels: {labels.tolist()[:30]}")
+    palette = _colors(cmap, (np.arange(labels.size) % 20 + 0.5) / 20
+                      if cmap == "tab20" else np.linspace(0, 1, labels.size))
+    alphas = {int(k): v for k, v in opacity.items()} if isinstance(opacity, dict) else {}
+    default = 0.3 if isinstance(opacity, dict) else opacity
+    table_rgb, table_alpha = [], []
+    for i, label in enumerate(labels.tolist()):
+        try:
+            rgb = matplotlib.colors.to_rgb(colors[label]) if label in colors else palette[i]
+        except ValueError:
+            raise ValueError(f"colors[{label}] = {colors[label]!r} is not a colour") from None
+        alpha = 0.0 if label in set(hidden) else float(alphas.get(label, default))
+        if not 0.0 <= alpha <= 1.0:
+            raise ValueError(f"opacity of label {label} must lie in [0, 1], got {alpha:g}")
+        table_rgb.append(rgb)
+        table_alpha.append(min(alpha, MAX_ALPHA))
+    # Entries every 1/4 from the first label - 1/2 to the last + 1/2: each label's value and
+    # its neighbours within 1/4 take that label's classification.
+    low, high = labels[0] - 0.5, labels[-1] + 0.5
+    grid = np.linspace(low, high, int(round((high - low) * 4)) + 1)
+    nearest = np.clip(np.searchsorted(labels, grid, side="left"), 0, labels.size - 1)
+    below = np.clip(nearest - 1, 0, labels.size - 1)
+    pick = np.where(np.abs(labels[below] - grid) < np.abs(labels[nearest] - grid), below,
+                    nearest)
+    if unit_distance is None:
+        unit_distance = float(np.min(volume.spacing))
+    return LookupTransfer.from_alpha(np.asarray(table_alpha)[pick],
+                                     np.asarray(table_rgb, dtype=np.float64)[pick],
+                                     unit_distance=unit_distance, value_range=(low, high),
+                                     shading=shading)

@@ -6,8 +6,9 @@ import inspect
 
 from vrlib import validate
 from vrlib._scheduling import thread_count
-from vrlib.arguments import framed_view, render_arguments
+from vrlib.arguments import framed_view, refuse_gradients, render_arguments
 from vrlib.colormapping import auto_transfer
+from vrlib.projection import BLENDS, render_projection
 from vrlib.raycast import render_raycast
 from vrlib.reference import render_reference
 from vrlib.shear import render_shear2, render_shear3
@@ -44,7 +45,8 @@ def method_options(method):
 
 
 def render(volume, view, *, method="raycast", filter="trilinear", transfer=None, step=0.5,
-           early_termination=0.999, empty_space_skipping=True, threads=None, **options):
+           early_termination=0.999, empty_space_skipping=True, blend="emission-absorption",
+           threads=None, **options):
     """Render a volume into an image.
 
     Parameters
@@ -72,6 +74,9 @@ def render(volume, view, *, method="raycast", filter="trilinear", transfer=None,
     empty_space_skipping : bool, default True
         Jump over blocks that the filter and transfer function make invisible; never changes
         the image.
+    blend : {"emission-absorption", "maximum", "average"}
+        Composite the samples front to back (the thesis's model), or project the largest or
+        the mean value along each ray (:mod:`vrlib.projection`; ray casting only, no shading).
     threads : int, optional
         Threads to use (default: numba's setting). The image does not depend on it.
     **options
@@ -112,6 +117,17 @@ def render(volume, view, *, method="raycast", filter="trilinear", transfer=None,
         raise TypeError(
             f"empty_space_skipping must be True or False, got {empty_space_skipping!r}"
         )
+    validate.choice("blend", blend, BLENDS)
+    if blend != "emission-absorption":
+        if method != "raycast":
+            raise ValueError(f"blend={blend!r} takes one value per ray, which ray casting "
+                             f"gives: use method='raycast' (not {method!r})")
+        refuse_gradients(transfer, f"blend={blend!r}", instead="blend='emission-absorption'")
+        if options:
+            raise TypeError(f"blend={blend!r} takes no method options, got {sorted(options)}")
+        with thread_count(threads):
+            return render_projection(volume, view, filt=filt, transfer=transfer, step=step,
+                                     blend=blend)
     allowed = method_options(method)
     unknown = sorted(set(options) - set(allowed))
     if unknown:

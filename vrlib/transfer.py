@@ -373,8 +373,10 @@ class LookupTransfer(TransferFunction):
         if np.any((a < 0.0) | (a >= 1.0)):
             raise ValueError("alpha entries must lie in [0, 1) (1 would be infinite density)")
         unit = validate.positive_number("unit_distance", unit_distance)
-        return cls(-np.log1p(-a) / unit, color, value_range=value_range, shading=shading,
+        made = cls(-np.log1p(-a) / unit, color, value_range=value_range, shading=shading,
                    gradient_opacity=gradient_opacity)
+        made.unit_distance = unit  # the projections classify one value over this distance
+        return made
 
     def _interp(self, table, values):
         values = np.asarray(values, dtype=np.float64)

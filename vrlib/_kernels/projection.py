@@ -1,0 +1,59 @@
+"""Kernel of the maximum- and average-intensity projections (:mod:`vrlib.projection`)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import prange
+
+from vrlib._kernels._jit import parallel_jit
+from vrlib._kernels.camera import pixel_ray, ray_box
+from vrlib._kernels.sampling import reconstruct, tap_scratch
+
+#: Blend codes: the largest reconstructed value along a ray, or their mean.
+MAXIMUM, AVERAGE = 0, 1
+
+
+@parallel_jit
+def project(data, gshape, origin, spacing, box_lo, box_hi, camera, height, width, ds, fkind,
+            fp0, fp1, fp2, radius, ntaps, blend, value, hit, samples):
+    """``value[row, col]``: the largest (``blend = MAXIMUM``) or mean (``AVERAGE``) value
+    reconstructed at the samples ``t = (k + 1/2) ds`` of the pixel's ray inside the box, the
+    same positions the ray caster samples; ``hit`` says whether the ray took any sample,
+    ``samples[row]`` counts them. Rows run in parallel, each pixel on its own: the image does
+    not depend on the thread count."""
+    inv0, inv1, inv2 = 1.0 / spacing[0], 1.0 / spacing[1], 1.0 / spacing[2]
+    offset = np.zeros(3, dtype=np.int64)
+    for r in prange(height):
+        wx, wy, wz, _, _, _ = tap_scratch()
+        taken = 0
+        for c in range(width):
+            o, d = pixel_ray(camera, height, width, r, c)
+            t_in, t_out = ray_box(o, d, box_lo, box_hi)
+            t_in = max(t_in, 0.0)
+            best = -math.inf
+            total = 0.0
+            count = 0
+            k = math.ceil(t_in / ds - 0.5)
+            while t_out > t_in:
+                t = (k + 0.5) * ds
+                if t >= t_out:
+                    break
+                v = reconstruct(data, offset, gshape, (o[0] + t * d[0] - origin[0]) * inv0,
+                                (o[1] + t * d[1] - origin[1]) * inv1,
+                                (o[2] + t * d[2] - origin[2]) * inv2, fkind, fp0, fp1, fp2,
+                                radius, ntaps, wx, wy, wz)
+                best = max(best, v)
+                total += v
+                count += 1
+                k += 1
+            hit[r, c] = count > 0
+            if count == 0:
+                value[r, c] = 0.0
+            elif blend == MAXIMUM:
+                value[r, c] = best
+            else:
+                value[r, c] = total / count
+            taken += count
+        samples[r] = taken
