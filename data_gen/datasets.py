@@ -73,7 +73,7 @@ def dataset_path(name):
     raise ValueError(f"no file for volume {name!r}; files exist for frog, aniso, brainsmall")
 
 
-def load_mni_template(*, resolution=2):
+def load_mni_template(*, resolution=2, nan="error"):
     """The MNI152 T1 template bundled inside nilearn (no download): a real MRI volume in mm.
 
     Raises
@@ -97,7 +97,8 @@ def load_mni_template(*, resolution=2):
         ) from exc
     if resolution not in (1, 2):
         raise ValueError(f"resolution must be 1 or 2 (mm), got {resolution!r}")
-    return nifti_volume(load_mni152_template(resolution=resolution), "MNI152 template")
+    return nifti_volume(load_mni152_template(resolution=resolution), "MNI152 template",
+                        nan=nan)
 
 
 def load_dataset(name, **options):

@@ -7,6 +7,9 @@ per voxel from the origin where the format has no header (``.npy``, raw). Views 
 angles alone frame any volume (:meth:`vrlib.View.fitted`), so no rescaling is needed; pass
 ``extent`` (e.g. :func:`fitted_extent`) to place a volume in another box.
 
+Every loader takes ``nan="transparent"`` to read NaN samples as holes (:mod:`vrlib.holes`);
+by default a file with NaN samples is refused.
+
 Orientation: NIfTI volumes are turned to the closest RAS+ axes of their affine (a LAS file
 renders as its RAS twin); DICOM slices are ordered along their normal. A rotation left over
 after that (an oblique acquisition) is not applied: the voxels stay on axis-aligned axes.
@@ -47,15 +50,15 @@ def _unreadable(path, kind, error):
     return ValueError(f"{Path(path).name} is not a readable {kind} file: {text}")
 
 
-def _volume(data, extent, spacing, origin):
+def _volume(data, extent, spacing, origin, nan):
     """A volume with ``extent`` if given, else ``spacing`` and ``origin`` (defaults 1, 0)."""
     if extent is not None:
-        return Volume(data, extent, copy=False)
+        return Volume(data, extent, nan=nan, copy=False)
     return Volume(data, spacing=(1.0, 1.0, 1.0) if spacing is None else spacing,
-                  origin=(0.0, 0.0, 0.0) if origin is None else origin, copy=False)
+                  origin=(0.0, 0.0, 0.0) if origin is None else origin, nan=nan, copy=False)
 
 
-def load_npy(path, *, spacing=None, origin=None, extent=None):
+def load_npy(path, *, spacing=None, origin=None, extent=None, nan="error"):
     """Load a 3-D ``.npy`` array stored ``[z, y, x]`` (memory-mapped while it is checked).
 
     Parameters
@@ -79,11 +82,11 @@ def load_npy(path, *, spacing=None, origin=None, extent=None):
         data = np.load(path, mmap_mode="r", allow_pickle=False)
     except (ValueError, OSError, EOFError) as error:
         raise _unreadable(path, ".npy", error) from None
-    return _volume(data, extent, spacing, origin)
+    return _volume(data, extent, spacing, origin, nan)
 
 
 def load_raw(path, shape, dtype, *, byteorder="little", offset=0, spacing=None, origin=None,
-             extent=None):
+             extent=None, nan="error"):
     """Load headerless samples of ``shape = (nz, ny, nx)`` and ``dtype``, x varying fastest.
 
     Parameters
@@ -121,7 +124,7 @@ def load_raw(path, shape, dtype, *, byteorder="little", offset=0, spacing=None, 
             f"header bytes needs {expected}"
         )
     data = np.memmap(path, dtype=dt, mode="r", offset=offset, shape=shape)
-    return _volume(data, extent, spacing, origin)
+    return _volume(data, extent, spacing, origin, nan)
 
 
 def nifti_orientation(image):
@@ -152,7 +155,7 @@ def nifti_orientation(image):
     return ornt, spacing, canonical[:3, 3].copy()
 
 
-def load_nifti(path, *, frame=None, extent=None):
+def load_nifti(path, *, frame=None, extent=None, nan="error"):
     """Load a NIfTI volume (``.nii``, ``.nii.gz``) through nibabel, turned to RAS+.
 
     Voxel axes become ``(x, y, z)`` = (right, anterior, superior) after the flips and swaps
@@ -184,10 +187,10 @@ def load_nifti(path, *, frame=None, extent=None):
         image = nibabel.load(path)
     except (OSError, EOFError, ValueError, nibabel.filebasedimages.ImageFileError) as error:
         raise _unreadable(path, "NIfTI", error) from None
-    return nifti_volume(image, path.name, frame=frame, extent=extent)
+    return nifti_volume(image, path.name, frame=frame, extent=extent, nan=nan)
 
 
-def nifti_volume(image, name, *, frame=None, extent=None):
+def nifti_volume(image, name, *, frame=None, extent=None, nan="error"):
     """The volume of a loaded nibabel image (as :func:`load_nifti`; ``name`` for messages).
 
     Examples
@@ -216,7 +219,7 @@ def nifti_volume(image, name, *, frame=None, extent=None):
     ornt, spacing, origin = nifti_orientation(image)
     data = orientations.apply_orientation(data, ornt)
     data = np.ascontiguousarray(data.transpose(2, 1, 0))  # (i, j, k) -> [z, y, x]
-    return _volume(data, extent, spacing, origin)
+    return _volume(data, extent, spacing, origin, nan)
 
 
 def _frame(name, shape, frame):
@@ -232,7 +235,7 @@ def _frame(name, shape, frame):
     return int(frame)
 
 
-def load_nrrd(path, *, extent=None):
+def load_nrrd(path, *, extent=None, nan="error"):
     """Load an NRRD file (``.nrrd``, or ``.nhdr`` with its data file) through pynrrd.
 
     Spacing from ``space directions`` (their lengths) or ``spacings``; origin from
@@ -266,10 +269,11 @@ def load_nrrd(path, *, extent=None):
     elif header.get("spacings") is not None:
         spacing = np.asarray(header["spacings"], dtype=np.float64)
     origin = header.get("space origin")
-    return _volume(data, extent, spacing, None if origin is None else np.asarray(origin, float))
+    origin = None if origin is None else np.asarray(origin, dtype=np.float64)
+    return _volume(data, extent, spacing, origin, nan)
 
 
-def load_tiff(path, *, spacing=None, extent=None):
+def load_tiff(path, *, spacing=None, extent=None, nan="error"):
     """Load a TIFF stack (one page per z slice, or an ImageJ hyperstack of one channel)
     through tifffile, memory-mapped when the file is uncompressed.
 
@@ -310,7 +314,7 @@ def load_tiff(path, *, spacing=None, extent=None):
     if data.ndim != 3:
         raise ValueError(f"{path.name} must hold a 3-D stack of one channel, got shape "
                          f"{data.shape} (axes {series.axes})")
-    return _volume(data, extent, found if spacing is None else spacing, None)
+    return _volume(data, extent, found if spacing is None else spacing, None, nan)
 
 
 def _tiff_spacing(tif):
@@ -326,7 +330,7 @@ def _tiff_spacing(tif):
     return (xd / xn, yd / yn, float(z))
 
 
-def load_vtk(path, *, scalars=None, extent=None):
+def load_vtk(path, *, scalars=None, extent=None, nan="error"):
     """Load VTK image data (``.vti``, or a legacy ``.vtk`` of structured points) through
     pyvista: its point scalars, origin and spacing.
 
@@ -364,20 +368,22 @@ def load_vtk(path, *, scalars=None, extent=None):
     if name is None or (name not in points and name not in cells):
         raise ValueError(f"{path.name}: no array {name!r}; point arrays {points}, cell arrays "
                          f"{cells} (choose one with scalars=)")
-    if name in points:
-        volume = Volume.from_pyvista(grid, name)
-        return volume if extent is None else Volume(volume.data, extent, copy=False)
-    nx, ny, nz = (n - 1 for n in grid.dimensions)
-    values = np.asarray(grid.cell_data[name])
-    if values.ndim != 1:
-        raise ValueError(f"{path.name}: array {name!r} must hold one value per cell, got "
-                         f"shape {values.shape}")
     spacing = np.asarray(grid.spacing, dtype=np.float64)
-    origin = np.asarray(grid.origin, dtype=np.float64) + spacing / 2
-    return _volume(values.reshape(nz, ny, nx), extent, spacing, origin)
+    origin = np.asarray(grid.origin, dtype=np.float64)
+    if name in points:
+        nx, ny, nz = grid.dimensions
+        values = np.asarray(grid.point_data[name])
+    else:  # cell data: one sample per cell, at its centre
+        nx, ny, nz = (n - 1 for n in grid.dimensions)
+        values = np.asarray(grid.cell_data[name])
+        origin = origin + spacing / 2
+    if values.ndim != 1:
+        raise ValueError(f"{path.name}: array {name!r} must hold one value per point or cell, got "
+                         f"shape {values.shape}")
+    return _volume(values.reshape(nz, ny, nx), extent, spacing, origin, nan)
 
 
-def load_dicom(folder, *, series=None, extent=None):
+def load_dicom(folder, *, series=None, extent=None, nan="error"):
     """Load a DICOM series (a folder of slice files) through pydicom.
 
     Slices are ordered by their position along the slice normal (``ImagePositionPatient``
@@ -431,10 +437,10 @@ def load_dicom(folder, *, series=None, extent=None):
     if len(members) < 2:
         raise ValueError(f"a DICOM series needs at least 2 slices, {folder.name} has "
                          f"{len(members)}")
-    return _stack_dicom(folder, members, extent)
+    return _stack_dicom(folder, members, extent, nan)
 
 
-def _stack_dicom(folder, members, extent):
+def _stack_dicom(folder, members, extent, nan):
     first = members[0][1]
     try:
         cosines = np.asarray(first.ImageOrientationPatient, dtype=np.float64).reshape(2, 3)
@@ -474,7 +480,7 @@ def _stack_dicom(folder, members, extent):
     data = np.stack(planes)
     first = members[order[0]][1]
     origin = np.asarray(first.ImagePositionPatient, dtype=np.float64)
-    return _volume(data, extent, (pixel[1], pixel[0], gap), origin)
+    return _volume(data, extent, (pixel[1], pixel[0], gap), origin, nan)
 
 
 # VolPack's .den header (Levoy's format): 28 shorts (version, then original, extracted and
@@ -482,7 +488,7 @@ def _stack_dicom(folder, members, extent):
 _DEN_HEADER = 62
 
 
-def load_den(path, *, extent=None):
+def load_den(path, *, extent=None, nan="error"):
     """Load a VolPack/Levoy ``.den`` density file (8-bit samples after a 62-byte header whose
     mapped lengths give the shape; either byte order, told by the version word).
 
@@ -519,7 +525,7 @@ def load_den(path, *, extent=None):
                          f"header says {size} ({'x'.join(map(str, lengths))}): truncated?")
     nx, ny, nz = lengths.tolist()
     data = np.frombuffer(raw, dtype=np.uint8, offset=_DEN_HEADER).reshape(nz, ny, nx)
-    return _volume(data, extent, None, None)
+    return _volume(data, extent, None, None, nan)
 
 
 def load(source, **options):

@@ -16,6 +16,7 @@ MODULES = [
     "data_gen.loaders", "vrlib.parallel.taxonomy", "vrlib.parallel.decompose",
     "vrlib.parallel.model", "vrlib.parallel.network", "vrlib.parallel.traffic",
     "vrlib.parallel.mpi", "vrlib.colormapping", "vrlib.projection", "vrlib.animation",
+    "vrlib.holes",
     "data_gen.datasets",
     "data_gen.dicom",
 ]

@@ -166,6 +166,19 @@ def test_labels_projections_and_turntables(tmp_path):
     assert done.returncode == 2 and "output must end in .gif or .mp4" in done.stderr
 
 
+def test_nan_samples_refused_or_holes(tmp_path):
+    data = np.ones((6, 6, 6))
+    data[2:4, 2:4, 2:4] = np.nan
+    np.save(tmp_path / "nan.npy", data)
+    done = run("render", str(tmp_path / "nan.npy"), "-o", str(tmp_path / "x.png"))
+    assert done.returncode == 2 and "nan='transparent'" in done.stderr
+    done = run("render", str(tmp_path / "nan.npy"), "--nan", "transparent", "--transfer",
+               "glow:1", "--size", "16", "--filter", "trilinear", "-o", str(tmp_path / "h.npy"))
+    assert done.returncode == 0, done.stderr
+    rgba = np.load(tmp_path / "h.npy")
+    assert np.all(np.isfinite(rgba)) and 0.0 < rgba[..., 3].max() < 1.0
+
+
 def test_render_a_dicom_folder(tmp_path):
     from data_gen.dicom import write_series
 

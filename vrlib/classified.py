@@ -30,6 +30,8 @@ from vrlib._kernels.classified import composite_classified, shade_table
 from vrlib._kernels.shear import warp
 from vrlib._scheduling import balanced_order, thread_count
 from vrlib.arguments import check_transfer, framed_view
+from vrlib.filters import make_filter
+from vrlib.holes import with_holes
 from vrlib.image import Image, RenderStats
 from vrlib.shearwarp import intermediate_plane, warp_homography
 from vrlib.transfer import Phong
@@ -145,8 +147,9 @@ class ClassifiedVolume:
                                                   high=1.0, high_open=True)
         start = time.perf_counter()
         data = volume.data
-        lo, hi = float(data.min()), float(data.max())
-        sigma = self.transfer.opacity_density(data)
+        lo, hi = volume.value_range  # holes left out: they classify as transparent
+        sigma = with_holes(volume, self.transfer, make_filter("box"), "classify").opacity_density(
+            data)
         normal = np.full(volume.shape, NORMAL_BINS**2, dtype=np.uint16)
         if self.transfer.needs_gradient:
             # Central differences (one-sided at the faces), per world unit: gz, gy, gx.

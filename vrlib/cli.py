@@ -55,7 +55,7 @@ def _number(text):
 
 
 def load_volume(spec, *, shape=None, dtype=None, offset=0, frame=None, series=None,
-                scalars=None):
+                scalars=None, nan="error"):
     """``(volume, field or None)`` from a command-line volume spec."""
     import data_gen
 
@@ -78,6 +78,8 @@ def load_volume(spec, *, shape=None, dtype=None, offset=0, frame=None, series=No
                 if not name.endswith(ending):
                     raise UsageError(f"--{key} applies to {' and '.join(ending)} files only")
                 options[key] = value
+        if nan != "error":
+            options["nan"] = nan
         if series is not None:
             if not path.is_dir():
                 raise UsageError("--series applies to a folder of DICOM slices only")
@@ -199,6 +201,9 @@ def _add_volume(parser, optional=False):
     parser.add_argument("--series", help="the series (SeriesInstanceUID or its end) of a "
                                          "DICOM folder holding several")
     parser.add_argument("--scalars", help="the point or cell array of a .vti/.vtk file")
+    parser.add_argument("--nan", default="error", choices=["error", "transparent"],
+                        help="NaN samples in a file: refuse them (default), or holes that "
+                             "contribute nothing")
 
 
 def _add_scene(parser):
@@ -234,7 +239,8 @@ def _filter(args):
 
 def _load(args):
     return load_volume(args.volume, shape=args.shape, dtype=args.dtype, offset=args.offset,
-                       frame=args.frame, series=args.series, scalars=args.scalars)
+                       frame=args.frame, series=args.series, scalars=args.scalars,
+                       nan=args.nan)
 
 
 def cmd_render(args):

@@ -14,7 +14,10 @@ import numpy as np
 from vrlib import validate
 from vrlib._kernels.points import reconstruct_points
 from vrlib.filters import check_radius, make_filter
+from vrlib.holes import with_holes
 from vrlib.prefilter import coefficient_volume
+from vrlib.transfer import Glow
+from vrlib.value_bounds import reconstructed_range
 from vrlib.volume import Volume
 
 __all__ = ["reconstruct", "INSIDE_TOLERANCE"]
@@ -43,7 +46,8 @@ def reconstruct(volume, points, *, filter="trilinear", derivative=False):
     -------
     ndarray, shape (n,) or (n, 3) with ``derivative``
         float64. Points outside the volume's box (by more than :data:`INSIDE_TOLERANCE`
-        voxels) give NaN: the field is defined inside the box only.
+        voxels) give NaN: the field is defined inside the box only; so do points whose
+        reconstruction gives a hole (a NaN sample of ``nan="transparent"``) any weight.
 
     Raises
     ------
@@ -79,6 +83,10 @@ def reconstruct(volume, points, *, filter="trilinear", derivative=False):
     pts = validate.finite_array("points", points)
     if pts.ndim != 2 or pts.shape[1] != 3:
         raise ValueError(f"points must have shape (n, 3) (x, y, z per row), got {pts.shape}")
+    holes = volume.holes is not None
+    if holes:
+        with_holes(volume, Glow(1.0), filt, "raycast")  # refuses what holes cannot take
+        low, high = reconstructed_range(volume, filt)
     if filt.prefiltered:
         volume, _ = coefficient_volume(volume, filt)
     index = np.ascontiguousarray(volume.world_to_index(pts))
@@ -89,6 +97,9 @@ def reconstruct(volume, points, *, filter="trilinear", derivative=False):
     last = np.array(volume.shape[::-1], dtype=np.float64) - 1.0
     outside = np.any((index < -INSIDE_TOLERANCE) | (index > last + INSIDE_TOLERANCE), axis=1)
     out[outside] = np.nan
+    if holes:  # a point that gives a hole weight has no value (vrlib.holes)
+        value = out[:, 0] if not derivative else reconstruct(volume, pts, filter=filt)
+        out[(value < low) | (value > high)] = np.nan
     if derivative:
         return out / volume.spacing  # index units to world units, per axis
     return out[:, 0]

@@ -8,6 +8,7 @@ from vrlib import validate
 from vrlib._scheduling import thread_count
 from vrlib.arguments import framed_view, refuse_gradients, render_arguments
 from vrlib.colormapping import auto_transfer
+from vrlib.holes import with_holes
 from vrlib.projection import BLENDS, render_projection
 from vrlib.raycast import render_raycast
 from vrlib.reference import render_reference
@@ -113,6 +114,7 @@ def render(volume, view, *, method="raycast", filter="trilinear", transfer=None,
     filt, transfer, step, early_termination = render_arguments(view, filter, transfer, step,
                                                                early_termination)
     view = framed_view(view, volume.extent, transfer, volume.value_range)
+    transfer = with_holes(volume, transfer, filt, method)
     if not isinstance(empty_space_skipping, bool):
         raise TypeError(
             f"empty_space_skipping must be True or False, got {empty_space_skipping!r}"

@@ -99,6 +99,11 @@ class Volume:
     origin : array_like of 3 floats, optional
         World position of sample ``data[0, 0, 0]``; default ``(0, 0, 0)`` when only
         ``spacing`` is given.
+    nan : {"error", "transparent"}, default "error"
+        What NaN samples mean. ``"error"`` refuses them; ``"transparent"`` makes each a hole
+        that contributes nothing (:mod:`vrlib.holes` states the rule): the sample is stored
+        as :attr:`hole_value`, far outside the data, and every renderer draws whatever a hole
+        reaches as transparent. Infinite samples are refused either way.
     copy : bool, default True
         Copy ``data``. With ``copy=False`` an array that already has the storage type is used
         as is (read-only view): do not modify it afterwards.
@@ -133,7 +138,8 @@ class Volume:
     [[0.0, 4.0], [0.0, 3.0], [0.0, 5.0]]
     """
 
-    def __init__(self, data, extent=None, *, spacing=None, origin=None, copy=True):
+    def __init__(self, data, extent=None, *, spacing=None, origin=None, nan="error",
+                 copy=True):
         arr = np.asarray(data)
         if arr.dtype.kind not in "iuf":
             raise TypeError(
@@ -149,18 +155,35 @@ class Volume:
             raise ValueError(
                 f"volume data needs at least 2 samples along every axis, got shape {arr.shape}"
             )
+        validate.choice("nan", nan, ("error", "transparent"))
         storage = storage_dtype(arr.dtype)
         arr = np.array(arr, dtype=storage, order="C", copy=True if copy else None)
+        self._holes = None
+        self._range = None
         if not np.all(np.isfinite(arr)):
+            holes = np.isnan(arr)
             bad = int(arr.size - np.count_nonzero(np.isfinite(arr)))
-            raise ValueError(f"volume data must be finite: found {bad} NaN or infinite sample(s)")
+            if nan == "error" or bad > np.count_nonzero(holes):
+                hint = "" if nan == "transparent" else " (nan='transparent' makes NaN holes)"
+                raise ValueError(f"volume data must be finite: found {bad} NaN or infinite "
+                                 f"sample(s){hint}")
+            if holes.all():
+                raise ValueError("volume data are all NaN: there is nothing to render")
+            from vrlib.holes import hole_value
+
+            valid = arr[~holes]
+            self._range = (float(valid.min()), float(valid.max()))
+            if not copy or arr.base is not None:
+                arr = arr.copy()
+            arr[holes] = hole_value(*self._range)
+            holes.flags.writeable = False
+            self._holes = holes
         if arr.base is not None or not copy:
             arr = arr.view()
         arr.flags.writeable = False
         self._data = arr
         self._extent = _world_box(arr.shape, extent, spacing, origin)
         self._derived = {}  # cached structures built from the samples (pyramids, runs)
-        self._range = None
 
     # -- lattice geometry ------------------------------------------------------------------
 
@@ -209,8 +232,24 @@ class Volume:
         return float(0.5 * np.linalg.norm(self._extent[:, 1] - self._extent[:, 0]))
 
     @property
+    def holes(self):
+        """Where the NaN samples of a volume made with ``nan="transparent"`` were (a read-only
+        boolean array like :attr:`data`), or None."""
+        return self._holes
+
+    @property
+    def hole_value(self):
+        """The value stored in place of each hole (None without holes)."""
+        if self._holes is None:
+            return None
+        from vrlib.holes import hole_value
+
+        return hole_value(*self.value_range)
+
+    @property
     def value_range(self):
-        """``(min, max)`` of the samples (computed once: the samples are read-only)."""
+        """``(min, max)`` of the samples, holes left out (computed once: the samples are
+        read-only)."""
         if self._range is None:
             self._range = (float(self._data.min()), float(self._data.max()))
         return self._range
