@@ -225,3 +225,23 @@ def test_truncated_files_say_so(tmp_path):
         data_gen.load(tmp_path / "t.den")
     with pytest.raises(FileNotFoundError, match="no volume file"):
         data_gen.load(tmp_path / "missing.npy")
+
+
+def test_real_files_that_dependencies_ship():
+    """Files written by other software, not by this test: pyvista's legacy structured points
+    (uniform.vtk) and its cell-data image (channels.vti, 250x250x100 cells), and
+    scikit-image's multi-page TIFF. (No DICOM series or NRRD volume ships in a wheel.)"""
+    from pathlib import Path
+
+    import skimage
+
+    examples = Path(pyvista.__file__).parent / "examples"
+    uniform = data_gen.load(examples / "uniform.vtk")
+    assert uniform.shape == (10, 10, 10) and uniform.value_range == (0.0, 729.0)
+    channels = data_gen.load(examples / "channels.vti")
+    assert channels.shape == (100, 250, 250)
+    np.testing.assert_allclose(channels.origin, [0.5, 0.5, 0.5])  # cell centres
+    stack = data_gen.load(Path(skimage.__file__).parent / "data" / "multipage.tif")
+    assert stack.shape == (2, 15, 10)
+    np.testing.assert_array_equal(stack.data, tifffile.imread(
+        Path(skimage.__file__).parent / "data" / "multipage.tif"))

@@ -55,17 +55,34 @@ def test_readme_python_example_runs(tmp_path, monkeypatch, capsys):
     assert (tmp_path / "blob.png").read_bytes()[:4] == b"\x89PNG"
 
 
+def test_readme_own_data_examples_run(tmp_path):
+    """The real-volume examples: the Python one renders the head, and each shell line runs
+    (at a small size, turntables with two frames)."""
+    namespace = {}
+    exec(compile("import vrlib, data_gen\n" + blocks("python")[2], "README.md", "exec"),
+         namespace)
+    assert 0.05 < namespace["img"].alpha.mean() < 0.6
+    block = next(b for b in blocks("bash") if "vrlib info frog" in b)
+    for line in block.strip().splitlines():
+        command = line.split("#")[0].strip()
+        extra = " --size 24" + (" --frames 2" if "turntable" in command else "")
+        done = shell(command + ("" if command.startswith("vrlib info") else extra), tmp_path)
+        assert done.returncode == 0, (command, done.stderr)
+    assert {"frog.png", "head.png", "mip.png", "head.gif"} <= {p.name for p in
+                                                               tmp_path.iterdir()}
+
+
 def test_readme_classified_example_runs(capsys):
     """The classify-once example renders its twelve frames (speed is the benchmarks' business:
     the line it prints only says each frame took under a second)."""
-    exec(compile(blocks("python")[2], "README.md", "exec"), {})
+    exec(compile(blocks("python")[3], "README.md", "exec"), {})
     count = capsys.readouterr().out.strip().splitlines()[-1].split()[0]
     assert count == "12"
 
 
 def test_readme_reconstruction_example_prints_what_it_says(capsys):
     """The point errors its comment quotes, in that order (the claim test's measurement)."""
-    exec(compile(blocks("python")[3], "README.md", "exec"), {})
+    exec(compile(blocks("python")[4], "README.md", "exec"), {})
     printed = [line.split() for line in capsys.readouterr().out.strip().splitlines()]
     assert [(name, float(value)) for name, value in printed] == [
         ("catmull-rom", 0.0219), ("cardinal-bspline", 0.0132), ("omoms", 0.0103)]
