@@ -52,6 +52,8 @@ def _unreadable(path, kind, error):
 
 def _volume(data, extent, spacing, origin, nan):
     """A volume with ``extent`` if given, else ``spacing`` and ``origin`` (defaults 1, 0)."""
+    if np.asarray(data).dtype == np.bool_:  # a mask: 0 and 1
+        data = np.asarray(data, dtype=np.uint8)
     if extent is not None:
         return Volume(data, extent, nan=nan, copy=False)
     return Volume(data, spacing=(1.0, 1.0, 1.0) if spacing is None else spacing,
@@ -209,9 +211,11 @@ def nifti_volume(image, name, *, frame=None, extent=None, nan="error"):
     if len(shape) == 3 and frame not in (None, 0):
         raise ValueError(f"frame: {name} is 3-D, it has no frame {frame}")
     proxy = image.dataobj
+    scaled = getattr(proxy, "slope", 1.0) != 1.0 or getattr(proxy, "inter", 0.0) != 0.0
     try:
+        # Unscaled samples keep their type (an uncompressed file stays memory-mapped).
         data = np.asarray(proxy[..., _frame(name, shape, frame)] if len(shape) == 4
-                          else proxy, dtype=np.float64)
+                          else proxy, dtype=np.float64 if scaled else None)
     except (OSError, EOFError, ValueError) as error:
         if str(error).startswith("frame"):
             raise

@@ -116,7 +116,11 @@ def test_bad_files_exit_2_with_one_line(tmp_path):
     (inputs / "bad.tif").write_bytes(b"II*\x00" + bytes(8))
     (inputs / "v.xyz").write_bytes(b"")
     np.save(inputs / "v.npy", np.zeros((4, 4, 4)))
+    from data_gen.dicom import write_series
+
+    write_series(inputs / "gap", np.zeros((5, 4, 4)))[2].unlink()
     for args, message in (
+            (["gap"], "unevenly spaced"),
             (["short.raw", "--shape", "4,4,5", "--dtype", "uint8"], "raw file holds 64 bytes"),
             (["bad.nii"], "not a readable NIfTI file"),
             (["bad.tif"], "not a readable TIFF file"),

@@ -245,3 +245,23 @@ def test_real_files_that_dependencies_ship():
     assert stack.shape == (2, 15, 10)
     np.testing.assert_array_equal(stack.data, tifffile.imread(
         Path(skimage.__file__).parent / "data" / "multipage.tif"))
+
+
+def test_masks_and_memory_maps(tmp_path):
+    """Boolean masks load as 0 and 1; an uncompressed float32 file stays memory-mapped
+    (its samples are not copied into memory)."""
+    mask = DATA > 500
+    np.save(tmp_path / "mask.npy", mask)
+    np.testing.assert_array_equal(data_gen.load(tmp_path / "mask.npy").data, mask)
+
+    def mapped(array):
+        while array is not None and not isinstance(array, np.memmap):
+            array = getattr(array, "base", None)
+        return array is not None
+
+    np.save(tmp_path / "f.npy", DATA.astype(np.float32))
+    assert mapped(data_gen.load(tmp_path / "f.npy").data)
+    _nifti(tmp_path / "f.nii", DATA.transpose(2, 1, 0).astype(np.float32), np.eye(4))
+    vol = data_gen.load(tmp_path / "f.nii")
+    np.testing.assert_array_equal(vol.data, DATA)
+    assert mapped(vol.data)

@@ -155,3 +155,16 @@ def test_metric_specific_errors():
         metrics.csf_error(np.zeros((4, 4)), np.ones((4, 4)), pixels_per_degree=-1)
     with pytest.raises(ValueError, match="must not be empty"):
         metrics.rmse(np.zeros(0), np.zeros(0))
+
+
+def test_an_image_shows_itself_in_a_notebook():
+    """Jupyter calls _repr_png_: the PNG that save() writes, composited over black."""
+    import io
+
+    import imageio.v3 as iio
+
+    rgba = np.zeros((3, 4, 4))
+    rgba[1, 2] = (0.25, 0.5, 0.0, 0.5)
+    data = Image(rgba)._repr_png_()
+    pixels = iio.imread(io.BytesIO(data))
+    assert pixels.shape == (3, 4, 3) and pixels[1, 2].tolist() == [64, 128, 0]
