@@ -183,6 +183,15 @@ def test_nan_samples_refused_or_holes(tmp_path):
     assert np.all(np.isfinite(rgba)) and 0.0 < rgba[..., 3].max() < 1.0
 
 
+def test_an_empty_image_says_why_in_one_line(tmp_path):
+    done = run("render", "gaussian-blob:12", "--cmap", "gray", "--opacity", "0:0,1:0", "--size",
+               "8", "-o", str(tmp_path / "e.png"))
+    lines = done.stderr.strip().splitlines()
+    assert done.returncode == 0 and len(lines) == 1, done.stderr
+    assert lines[0].startswith("vrlib: warning: the transfer function") and "transparent" in \
+        lines[0]
+
+
 def test_render_a_dicom_folder(tmp_path):
     from data_gen.dicom import write_series
 

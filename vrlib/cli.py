@@ -9,10 +9,13 @@ from __future__ import annotations
 import argparse
 import platform
 import sys
+import warnings
 from functools import partial
 from pathlib import Path
 
 import numpy as np
+
+from vrlib.arguments import EmptyImageWarning
 
 EXAMPLES = """examples:
   vrlib render marschner-lobb:41 -o ml.png
@@ -490,11 +493,19 @@ def main(argv=None):
     """
     args = parser().parse_args(argv)
     try:
-        args.run(args)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", EmptyImageWarning)
+            args.run(args)
     except (UsageError, ValueError, TypeError, FileNotFoundError, ImportError) as error:
         message = str(error).splitlines()[0] if str(error) else type(error).__name__
         print(f"vrlib: error: {message}", file=sys.stderr)
         return 2
+    for warning in caught:  # one line each, as the errors
+        if issubclass(warning.category, EmptyImageWarning):
+            print(f"vrlib: warning: {warning.message}", file=sys.stderr)
+        else:
+            warnings.showwarning(warning.message, warning.category, warning.filename,
+                                 warning.lineno)
     return 0
 
 
