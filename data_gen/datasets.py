@@ -9,12 +9,12 @@ aniso      anisotropic-voxel brain MRI (dipy test data)      dipy (``vrlib[data]
 brainsmall VolPack's MRI head example, 128x128x84, 8 bit     Debian's libvolpack1-dev
 ========== ================================================ ==========================
 
-Licences, as their packages state them: the MNI152 template (ICBM 2009, McConnell Brain
+Licences, as their packages state them: the MNI152 template (ICBM 2009c, McConnell Brain
 Imaging Centre) may be used, copied and distributed with its copyright notice kept, as
-nilearn ships it; pyvista's example data is MIT-licensed with pyvista (the frog tissues come
-from the Lawrence Berkeley Laboratory's Whole Frog Project, as VTK's examples use them);
-dipy's data files are BSD-3-Clause with dipy; VolPack (and its example head) is distributed
-under its own permissive licence by Stanford (Debian's ``copyright`` file for libvolpack1).
+nilearn ships it; pyvista's example data comes with pyvista under the MIT licence (the frog
+tissues are the segmentation of the Whole Frog Project's frog, as VTK's examples use it);
+dipy's data files are BSD-3-Clause with dipy; VolPack and its example head are BSD-3-Clause
+(Debian's ``copyright`` file for libvolpack1: Stanford's licence since 2007).
 """
 
 from __future__ import annotations
