@@ -88,8 +88,10 @@ report-check: $(REPORT)
 		exit 1)
 	$(PY) docs/report_check.py build/report/html
 
+# Two workers (pytest-xdist): the suite's time goes mostly into compiling kernels, which two
+# processes do side by side; test ids are the same in every process, as xdist needs.
 test: $(INSTALLED)
-	$(PY) -m pytest -m "not slow"
+	$(PY) -m pytest -m "not slow" -n 2
 
 # Everything, slow checks included, then the kernels' comparisons with their naive twins again
 # with the JIT off, so that the numba kernels also run (and agree) as plain Python.

@@ -150,6 +150,7 @@ def test_real_volumes_render_by_name_with_their_transfer_functions(tmp_path):
     assert "spacing (x, y, z): 4, 4, 5" in done.stdout and "histogram" in done.stdout
 
 
+@pytest.mark.slow  # labels, projections and turntables are tested in-process in make test
 def test_labels_projections_and_turntables(tmp_path):
     """The frog's labels (nearest-sample filter by default), a maximum-intensity projection,
     and turntables as GIF and MP4."""

@@ -267,6 +267,7 @@ def test_masks_and_memory_maps(tmp_path):
     assert mapped(vol.data)
 
 
+@pytest.mark.slow  # a float64 kernel per method to compile; ch10 measures the same on make all
 def test_anisotropic_voxels_in_every_method():
     """dipy's 4 x 4 x 5 mm volume: every method agrees with a fine ray cast of the same box,
     and the box matters (the same samples on cubic voxels give a visibly different image)."""

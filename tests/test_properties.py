@@ -17,6 +17,10 @@ from hypothesis.extra.numpy import arrays
 import vrlib
 from vrlib.compositing import composite
 
+# The drawn volumes include empty ones (all zeros) on purpose: their images must be finite
+# too. The warning that such an image is empty is checked in test_formats.
+pytestmark = pytest.mark.filterwarnings("ignore::vrlib.arguments.EmptyImageWarning")
+
 METHODS = list(vrlib.METHODS)
 # Every filter in make test-all; in make test the two most used (each filter compiles its own
 # kernels, and the property tests alone would pay a minute of make test's budget for them;

@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 ROOT = Path(__file__).resolve().parent.parent
 README = ROOT / "README.md"
@@ -55,6 +56,7 @@ def test_readme_python_example_runs(tmp_path, monkeypatch, capsys):
     assert (tmp_path / "blob.png").read_bytes()[:4] == b"\x89PNG"
 
 
+@pytest.mark.slow  # five commands on the real volumes; the CLI tests cover each feature
 def test_readme_own_data_examples_run(tmp_path):
     """The real-volume examples: the Python one renders the head, and each shell line runs
     (at a small size, turntables with two frames)."""
