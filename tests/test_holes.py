@@ -100,3 +100,17 @@ def test_hole_rules_and_errors():
         vrlib.render(vol, vrlib.View.orbit(size=4), filter="cardinal-bspline")
     lo, hi = reconstructed_range(vol, vrlib.make_filter("catmull-rom"))
     assert lo < 0.0 < 26.0 < hi < 1e3
+
+
+def test_automatic_and_label_transfer_functions_leave_holes_out():
+    """The histogram ramp and the label table are built from the finite samples only: a
+    volume with holes gets the ramp of its finite samples."""
+    pocket, holed = pocket_and_holes()
+    auto = vrlib.auto_transfer(holed)
+    assert auto.value_range[1] <= holed.value_range[1]
+    view = vrlib.View.orbit(azimuth=30, elevation=20, size=12)
+    assert vrlib.render(holed, view, transfer=auto).alpha.max() > 0.1
+    labels = vrlib.Volume(np.where(np.isnan(holed.data) | (holed.data > 1e10), np.nan,
+                                   np.round(pocket.data * 3)), nan="transparent")
+    table = vrlib.label_transfer(labels)
+    assert table.value_range == (-0.5, 3.5)

@@ -379,13 +379,15 @@ def describe_volume(volume):
     range, percentiles and a text histogram."""
     import vrlib
 
-    data = volume.data.ravel()
+    data = vrlib.colormapping.finite_values(volume)
     low, high = volume.value_range
     ext = " x ".join(f"[{a:g}, {b:g}]" for a, b in volume.extent)
     lines = [f"shape (z, y, x): {volume.shape}, stored as {volume.dtype}",
              f"spacing (x, y, z): {', '.join(f'{v:g}' for v in volume.spacing)}",
              f"world box: {ext}",
              f"values: {low:g} .. {high:g}"]
+    if volume.holes is not None:
+        lines.append(f"holes (NaN samples): {int(volume.holes.sum())}")
     percent = (1, 5, 25, 50, 75, 95, 99)
     values = np.percentile(data, percent)
     lines.append("percentiles: " + ", ".join(f"{p}%: {v:.4g}" for p, v in zip(percent, values,

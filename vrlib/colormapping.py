@@ -17,7 +17,8 @@ import numpy as np
 from vrlib import validate
 from vrlib.transfer import LookupTransfer
 
-__all__ = ["colormap", "auto_transfer", "label_transfer", "parse_opacity", "MAX_ALPHA"]
+__all__ = ["colormap", "auto_transfer", "label_transfer", "parse_opacity", "finite_values",
+           "MAX_ALPHA"]
 
 #: Opacity points are capped below 1 (infinite density) at this value.
 MAX_ALPHA = 1.0 - 1e-6
@@ -65,6 +66,20 @@ def _check_points(points):
     if np.any((pts[:, 1] < 0) | (pts[:, 1] > 1)):
         raise ValueError(f"opacity points' alpha must lie in [0, 1], got {pts[:, 1].tolist()}")
     return pts
+
+
+def finite_values(volume):
+    """The volume's samples, flat, holes (NaN samples of ``nan="transparent"``) left out.
+
+    Examples
+    --------
+    >>> from vrlib import Volume
+    >>> data = np.arange(8.0).reshape(2, 2, 2); data[0, 0, 0] = np.nan
+    >>> finite_values(Volume(data, nan="transparent")).tolist()
+    [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]
+    """
+    values = volume.data.ravel()
+    return values if volume.holes is None else values[~volume.holes.ravel()]
 
 
 def _colors(cmap, positions):
@@ -171,7 +186,7 @@ def auto_transfer(volume, cmap="gray", *, shading=None, peak_alpha=0.25):
                          "to tell apart; choose a transfer function")
     peak = validate.finite_number("peak_alpha", peak_alpha, low=0.0, high=1.0, low_open=True,
                                   high_open=True)
-    values = volume.data.ravel()
+    values = finite_values(volume)
     if values.size > 2_000_000:  # a regular subsample keeps the histogram, costs little
         values = values[:: values.size // 1_000_000]
     threshold = float(threshold_otsu(values.astype(np.float64)))
@@ -220,7 +235,7 @@ def label_transfer(volume, *, colors=None, opacity=0.3, hidden=(0,), cmap="tab20
     """
     import matplotlib.colors
 
-    values = np.unique(volume.data)
+    values = np.unique(finite_values(volume))
     if values.size > 4096 or not np.all(values == np.round(values)):
         raise ValueError("a label volume holds integer labels (at most 4096 of them); this one "
                          f"holds {values.size} values, e.g. {values[:3].tolist()}: use "
