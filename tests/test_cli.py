@@ -97,6 +97,11 @@ def test_render_reads_files(tmp_path):
     (["render", "frog", "--cmap", "nosuchmap", "-o", "x.png"], "unknown colormap"),
     (["render", "frog", "--clim", "0,1", "-o", "x.png"], "--clim applies with --opacity"),
     (["render", "frog", "--frame", "1", "-o", "x.png"], "--frame applies to .nii"),
+    (["render", "gaussian-blob:8", "-o", "missing/x.png"], "no folder 'missing' for the output"),
+    (["render", "gaussian-blob:8", "-o", "/etc/hostname/x.png"], "is a file"),
+    (["turntable", "gaussian-blob:8", "-o", "missing/x.gif"], "no folder"),
+    (["compare", "gaussian-blob:8", "-o", "missing/x.png"], "no folder"),
+    (["render", "marschner-lobb:3000", "-o", "x.png"], "samples per axis fit"),
 ])
 def test_bad_input_exits_2_with_one_line(tmp_path, args, message):
     done = run(*args, cwd=tmp_path)
@@ -205,6 +210,11 @@ def test_render_a_dicom_folder(tmp_path):
     assert np.load(out)[..., 3].max() > 0.1
 
 
+def test_version():
+    done = run("--version")
+    assert done.returncode == 0 and done.stdout.strip() == f"vrlib {vrlib.__version__}"
+
+
 def test_argparse_errors_exit_2():
     done = run("render", "marschner-lobb:17")  # no -o
     assert done.returncode == 2 and "-o/--output" in done.stderr
@@ -223,7 +233,7 @@ def test_compare_prints_a_table_and_saves_a_figure(tmp_path):
     assert done.returncode == 0, done.stderr
     for method in vrlib.METHODS:
         assert method in done.stdout
-    assert "reference renderer" in done.stdout
+    assert "reference renderer" in done.stdout and "after a warm-up render" in done.stdout
     assert out.read_bytes().startswith(b"\x89PNG")
 
 
