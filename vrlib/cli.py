@@ -253,8 +253,9 @@ def _add_volume(parser, optional=False):
 
 def _add_scene(parser):
     _add_volume(parser)
-    parser.add_argument("--filter", help="reconstruction filter (default catmull-rom; box "
-                                         "with --labels)")
+    parser.add_argument("--filter", help="reconstruction filter: box, trilinear (or pyramid), "
+                        "gaussian, catmull-rom, mitchell, bspline, cardinal-bspline or omoms "
+                        "(default catmull-rom; box with --labels)")
     parser.add_argument("--transfer", help=TRANSFER_HELP)
     parser.add_argument("--cmap", help="a matplotlib colormap name (bone, viridis, ...)")
     parser.add_argument("--opacity", help="opacity points X:ALPHA,... with X a fraction of "
@@ -266,13 +267,17 @@ def _add_scene(parser):
                         help="a label volume: one colour per label (--cmap, default tab20), "
                              "label 0 transparent, nearest-sample filter")
     parser.add_argument("--shade", action="store_true", help="Phong shading (gradients)")
-    parser.add_argument("--azimuth", type=float, default=30.0)
-    parser.add_argument("--elevation", type=float, default=20.0)
+    parser.add_argument("--azimuth", type=float, default=30.0,
+                        help="degrees about the world z axis, from +x (default 30)")
+    parser.add_argument("--elevation", type=float, default=20.0,
+                        help="degrees above the xy plane (default 20)")
     parser.add_argument("--size", type=int, default=256, help="image size in pixels")
     parser.add_argument("--projection", default="orthographic",
                         choices=["orthographic", "perspective"])
-    parser.add_argument("--zoom", type=float, default=1.0)
-    parser.add_argument("--step", type=float, default=0.5, help="ray step in voxels")
+    parser.add_argument("--zoom", type=float, default=1.0,
+                        help="magnification; at 1 the image spans the volume's bounding sphere")
+    parser.add_argument("--step", type=float, default=0.5,
+                        help="sample spacing along rays, in voxels (default 0.5)")
 
 
 def _filter(args):
