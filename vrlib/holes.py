@@ -32,7 +32,7 @@ import numpy as np
 
 from vrlib.transfer import TransferFunction
 
-__all__ = ["hole_value", "HoleTransfer", "with_holes", "HOLE_SCALE"]
+__all__ = ["hole_value", "HoleTransfer", "with_holes", "check_holes", "HOLE_SCALE"]
 
 #: A hole's stored value lies this many data ranges above the data.
 HOLE_SCALE = 1e20
@@ -78,9 +78,8 @@ class HoleTransfer(TransferFunction):
         self.inner = inner
         self.shading = inner.shading
         self.gradient_opacity = inner.gradient_opacity
-        self.unit_distance = getattr(inner, "unit_distance", None)
-        if self.unit_distance is None:
-            del self.unit_distance
+        if hasattr(inner, "unit_distance"):  # the projections' unit (vrlib.projection)
+            self.unit_distance = inner.unit_distance
         start, stop, pieces = inner._smooth_pieces(float(low), float(high))
         step = (stop - start) / pieces if stop > start else max(high - low, 1.0)
         # The grid of inner's table, from two steps below low to two above high.
@@ -131,12 +130,28 @@ def with_holes(volume, transfer, filt, method):
 
     if volume.holes is None:
         return transfer
+    check_holes(filt, transfer, method)
+    return HoleTransfer(transfer, *reconstructed_range(volume, filt))
+
+
+def check_holes(filt, transfer=None, method="raycast"):
+    """Refuse what holes cannot take (module docs): a prefiltered filter, or shading and
+    gradient opacity outside ray casting.
+
+    Examples
+    --------
+    >>> from vrlib import make_filter
+    >>> try:
+    ...     check_holes(make_filter("cardinal-bspline"))
+    ... except ValueError as error:
+    ...     print(str(error)[:48])
+    filter 'cardinal-bspline' prefilters along whole
+    """
     if filt.prefiltered:
         raise ValueError(f"filter {filt.name!r} prefilters along whole lines, so a hole would "
                          "reach every sample of its line: with NaN holes use a filter applied "
                          "to the samples (e.g. 'catmull-rom', 'trilinear', 'box')")
-    if transfer.needs_gradient and method != "raycast":
+    if transfer is not None and transfer.needs_gradient and method != "raycast":
         raise ValueError(f"with NaN holes, shading and gradient opacity are ray cast only "
                          f"(method {method!r} takes gradients from differences of samples, "
                          "which a hole would distort): use method='raycast'")
-    return HoleTransfer(transfer, *reconstructed_range(volume, filt))

@@ -14,9 +14,8 @@ import numpy as np
 from vrlib import validate
 from vrlib._kernels.points import reconstruct_points
 from vrlib.filters import check_radius, make_filter
-from vrlib.holes import with_holes
+from vrlib.holes import check_holes
 from vrlib.prefilter import coefficient_volume
-from vrlib.transfer import Glow
 from vrlib.value_bounds import reconstructed_range
 from vrlib.volume import Volume
 
@@ -85,7 +84,7 @@ def reconstruct(volume, points, *, filter="trilinear", derivative=False):
         raise ValueError(f"points must have shape (n, 3) (x, y, z per row), got {pts.shape}")
     holes = volume.holes is not None
     if holes:
-        with_holes(volume, Glow(1.0), filt, "raycast")  # refuses what holes cannot take
+        check_holes(filt)
         low, high = reconstructed_range(volume, filt)
     if filt.prefiltered:
         volume, _ = coefficient_volume(volume, filt)

@@ -15,7 +15,7 @@ from scipy import ndimage
 from vrlib import validate
 
 __all__ = ["Volume", "MinMaxPyramid", "DEFAULT_EXTENT", "check_extent", "fitted_extent",
-           "storage_dtype"]
+           "lattice_extent", "storage_dtype"]
 
 #: The default world box, ``[[xmin, xmax], [ymin, ymax], [zmin, zmax]]``: the cube [-1, 1]^3.
 DEFAULT_EXTENT = ((-1.0, 1.0), (-1.0, 1.0), (-1.0, 1.0))
@@ -453,6 +453,20 @@ def fitted_extent(shape, spacing=(1.0, 1.0, 1.0)):
     return np.stack([-half, half], axis=1)
 
 
+def lattice_extent(shape, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0)):
+    """World box of a ``(nz, ny, nx)`` lattice whose first sample lies at ``origin`` with
+    ``(dx, dy, dz)`` ``spacing`` (the rule of :class:`Volume`'s ``spacing`` and ``origin``).
+
+    Examples
+    --------
+    >>> lattice_extent((2, 3, 5), spacing=(1, 1, 2.5), origin=(10, 0, 0)).tolist()
+    [[10.0, 14.0], [0.0, 2.0], [0.0, 2.5]]
+    """
+    start = np.asarray(origin, dtype=np.float64)
+    sizes = (np.array(shape[::-1], dtype=np.float64) - 1.0) * np.asarray(spacing, float)
+    return np.stack([start, start + sizes], axis=1)
+
+
 def _world_box(shape, extent, spacing, origin):
     """The checked world box from ``extent``, or ``spacing`` and ``origin``, or the default."""
     if extent is not None:
@@ -466,8 +480,7 @@ def _world_box(shape, extent, spacing, origin):
     if np.any(step <= 0.0):
         raise ValueError(f"spacing must be positive along x, y and z, got {step.tolist()}")
     start = np.zeros(3) if origin is None else validate.vector3("origin", origin)
-    sizes = (np.array(shape[::-1], dtype=np.float64) - 1.0) * step
-    return check_extent(np.stack([start, start + sizes], axis=1))
+    return check_extent(lattice_extent(shape, step, start))
 
 
 def check_extent(extent):

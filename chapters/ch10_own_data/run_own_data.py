@@ -15,7 +15,7 @@ Writes ``build/results/ch10_own_data/own_data.json`` and ``images.npz``.
 """
 
 import tempfile
-import time
+from functools import partial
 from pathlib import Path
 
 import nibabel
@@ -29,6 +29,8 @@ import vrlib
 from chapters.common import ROOT, by_profile, progress, result_path, write_json
 from data_gen.dicom import write_series
 from vrlib.atomic import atomic_path
+from vrlib.cost import measure
+from vrlib.gradients import gradient_volumes
 
 SIZE = by_profile(192, 384)
 VIEW = {"azimuth": 120.0, "elevation": 20.0, "size": SIZE}
@@ -74,12 +76,6 @@ def write_formats(volume, folder):
     return files
 
 
-def timed(call):
-    start = time.perf_counter()
-    out = call()
-    return out, time.perf_counter() - start
-
-
 def formats(mni, transfer, view):
     reference = vrlib.render(mni, view, transfer=transfer)
     rows = []
@@ -87,7 +83,8 @@ def formats(mni, transfer, view):
     with tempfile.TemporaryDirectory(dir=ROOT / "build") as folder:
         for label, (path, options) in progress(write_formats(mni, Path(folder)).items(),
                                                "formats"):
-            volume, seconds = timed(lambda p=path, o=options: data_gen.load(p, **o))
+            seconds, volume = measure(partial(data_gen.load, path, **options), repeats=1,
+                                      warmup=False)
             image = vrlib.render(volume, view, transfer=transfer)
             rows.append({"format": label, "shape": list(volume.shape),
                          "spacing": [float(s) for s in volume.spacing],
@@ -104,8 +101,7 @@ def transfer_kinds(mni, frog):
                           shading=shaded)
     # Opaque only where the gradient magnitude (per mm) passes its 75th percentile inside the
     # head: boundaries between tissues, not their insides.
-    magnitude = np.linalg.norm(np.gradient(np.asarray(mni.data, float), *mni.spacing[::-1]),
-                               axis=0)
+    magnitude = np.linalg.norm(gradient_volumes(mni), axis=0)
     inside = magnitude[mni.data > 0.3 * mni.value_range[1]]
     edges = [float(np.percentile(inside, q)) for q in (75, 95)]
     by_gradient = vrlib.colormap("bone", [(0, 0), (0.3, 0), (0.6, 0.6), (1, 0.9)], volume=mni,

@@ -5,7 +5,8 @@ A source is an analytic field (each rank evaluates its brick and ghost samples,
 the pages of its brick: ``.npy``, uncompressed NIfTI (``.nii``) or headerless samples
 (:class:`RawFile`). Either way the ranks share one global sample lattice (:class:`Lattice`),
 so bricks render on the same ray lattice and join without seams. A file's world box is the
-one :func:`data_gen.load` gives it (voxel units, or the NIfTI affine's RAS+ box).
+one :func:`data_gen.load` gives it (one unit per voxel from the origin for files without a
+header, :func:`vrlib.volume.lattice_extent`; the NIfTI affine's RAS+ box).
 Samples of 8- and 16-bit integers, float16 and float32 are read as float32, others as
 float64, as :class:`vrlib.Volume` stores them, so a brick holds no more than its share.
 """
@@ -22,7 +23,7 @@ from mpi4py import MPI
 
 from vrlib import validate
 from vrlib.value_bounds import value_bounds
-from vrlib.volume import storage_dtype
+from vrlib.volume import lattice_extent, storage_dtype
 
 __all__ = ["Lattice", "RawFile", "open_source", "memory_map", "ghost", "global_value_range"]
 
@@ -42,7 +43,7 @@ class Lattice:
     @property
     def extent(self):
         """World box ``[[xmin, xmax], [ymin, ymax], [zmin, zmax]]`` of the whole lattice."""
-        return np.stack(self.box((0, 0, 0), self.cells), axis=1)
+        return lattice_extent(self.shape, self.spacing, self.origin)
 
     def box(self, lo, hi):
         """World box (x, y, z arrays) of cells ``[lo, hi)``."""
@@ -90,7 +91,7 @@ def memory_map(source):
         offset = validate.positive_int("offset", source.offset, minimum=0)
         _check_size(path, offset + math.prod(shape) * dtype.itemsize, shape, dtype, offset)
         array = np.memmap(path, dtype=dtype, mode="r", offset=offset, shape=shape)
-        return array, _voxel_box(shape), None
+        return array, lattice_extent(shape), None
     path = _file(source)
     name = path.name.lower()
     if name.endswith(".npy"):
@@ -100,7 +101,7 @@ def memory_map(source):
             raise ValueError(f"source {path.name} is not a readable .npy file: {error}") \
                 from None
         _check_3d(path, array.shape)
-        return array, _voxel_box(array.shape), None
+        return array, lattice_extent(array.shape), None
     if name.endswith(".nii"):
         return _map_nifti(path)
     if name.endswith(".nii.gz"):
@@ -108,11 +109,6 @@ def memory_map(source):
                          "brick from the file: decompress it (gunzip) to a .nii file")
     raise ValueError(f"source {path.name} is not a format a rank can read its brick from: use "
                      ".npy, .nii or vrlib.parallel.sources.RawFile(path, shape, dtype)")
-
-
-def _voxel_box(shape):
-    """The world box of a file without a header: one unit per voxel from the origin."""
-    return np.stack([np.zeros(3), np.array(shape[::-1], dtype=np.float64) - 1.0], axis=1)
 
 
 def _file(path):
@@ -161,8 +157,7 @@ def _map_nifti(path):
     array = np.memmap(path, dtype=dtype, mode="r", offset=offset, shape=shape[::-1])
     array = orientations.apply_orientation(array.T, ornt).T  # [z, y, x] of the RAS+ axes
     scaling = None if (slope, intercept) == (1.0, 0.0) else (slope, intercept)
-    sizes = (np.array(array.shape[::-1], dtype=np.float64) - 1.0) * spacing
-    return array, np.stack([origin, origin + sizes], axis=1), scaling
+    return array, lattice_extent(array.shape, spacing, origin), scaling
 
 
 def open_source(source, shape, extent):
