@@ -30,14 +30,6 @@ __all__ = ["load", "load_npy", "load_nifti", "load_raw", "load_nrrd", "load_tiff
            "load_dicom", "load_den", "fitted_extent", "nifti_orientation", "nifti_volume",
            "FORMATS"]
 
-#: File kinds :func:`load` reads, by name ending (a DICOM series is a folder).
-FORMATS = {".npy": "NumPy array", ".nii": "NIfTI", ".nii.gz": "NIfTI (gzip)",
-           ".raw": "raw samples (shape and dtype given)", ".nrrd": "NRRD", ".nhdr": "NRRD header",
-           ".tif": "TIFF stack", ".tiff": "TIFF stack", ".vti": "VTK XML image data",
-           ".vtk": "VTK legacy structured points", ".den": "VolPack density",
-           "folder": "DICOM series"}
-
-
 def _existing(path):
     path = Path(path)
     if not path.is_file():
@@ -532,6 +524,12 @@ def load_den(path, *, extent=None, nan="error"):
     return _volume(data, extent, None, None, nan)
 
 
+#: The loader :func:`load` takes for each file name ending (a DICOM series is a folder).
+FORMATS = {".npy": load_npy, ".nii": load_nifti, ".nii.gz": load_nifti, ".raw": load_raw,
+           ".nrrd": load_nrrd, ".nhdr": load_nrrd, ".tif": load_tiff, ".tiff": load_tiff,
+           ".vti": load_vtk, ".vtk": load_vtk, ".den": load_den}
+
+
 def load(source, **options):
     """Load a volume from a file, a DICOM folder, or a named real volume
     (:data:`data_gen.datasets.DATASETS`: ``mni152``, ``frog``, ``aniso``, ``brainsmall``).
@@ -562,10 +560,7 @@ def load(source, **options):
     if path.is_dir():
         return load_dicom(path, **options)
     name = path.name.lower()
-    for ending, loader in ((".npy", load_npy), (".nii", load_nifti), (".nii.gz", load_nifti),
-                           (".raw", load_raw), (".nrrd", load_nrrd), (".nhdr", load_nrrd),
-                           (".tif", load_tiff), (".tiff", load_tiff), (".vti", load_vtk),
-                           (".vtk", load_vtk), (".den", load_den)):
+    for ending, loader in FORMATS.items():
         if name.endswith(ending):
             if ending == ".raw" and not {"shape", "dtype"} <= set(options):
                 raise ValueError("a .raw file needs shape=(nz, ny, nx) and dtype= (on the "
@@ -573,7 +568,7 @@ def load(source, **options):
             return loader(path, **options)
     if not path.exists():
         raise FileNotFoundError(f"no volume file or folder at {str(source)!r}")
-    endings = ", ".join(e for e in FORMATS if e != "folder")
+    endings = ", ".join(FORMATS)
     raise ValueError(f"cannot tell the format of {str(source)!r}: use a file ending in "
                      f"{endings}, a folder of DICOM slices, or one of the named volumes "
                      f"{', '.join(datasets.DATASETS)}")

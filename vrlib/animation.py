@@ -76,7 +76,7 @@ def turntable(volume, path, *, frames=36, elevation=20.0, size=256, zoom=1.0, fp
         view = View.orbit(azimuth=float(azimuth), elevation=elevation, size=size, zoom=zoom)
         image = render(volume, view, **options)
         images.append(image)
-        pixels.append(np.round(np.clip(image.composited(), 0.0, 1.0) * 255).astype(np.uint8))
+        pixels.append(image.quantised())
     with atomic_path(path) as tmp:
         if suffix == ".gif":
             iio.imwrite(tmp, np.stack(pixels), extension=".gif", duration=1000.0 / fps,

@@ -96,7 +96,7 @@ def load_volume(spec, *, shape=None, dtype=None, offset=0, frame=None, series=No
     path = Path(spec)
     name = path.name.lower()
     if spec in data_gen.DATASETS or path.is_dir() or any(
-            name.endswith(e) for e in data_gen.FORMATS if e != "folder"):
+            name.endswith(e) for e in data_gen.FORMATS):
         if not (spec in data_gen.DATASETS or path.exists()):
             raise UsageError(f"volume file not found: {spec}")
         options = {}

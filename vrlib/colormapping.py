@@ -82,7 +82,8 @@ def finite_values(volume):
     return values if volume.holes is None else values[~volume.holes.ravel()]
 
 
-def _colors(cmap, positions):
+def _colormap(cmap):
+    """A matplotlib colormap from itself or its name."""
     import matplotlib
 
     if isinstance(cmap, str):
@@ -94,7 +95,11 @@ def _colors(cmap, positions):
                              f"(e.g. {names}, ...)") from None
     if not callable(cmap):
         raise TypeError(f"cmap must be a matplotlib colormap or its name, got {cmap!r}")
-    return np.asarray(cmap(positions), dtype=np.float64)[:, :3]
+    return cmap
+
+
+def _colors(cmap, positions):
+    return np.asarray(_colormap(cmap)(positions), dtype=np.float64)[:, :3]
 
 
 def colormap(cmap="gray", opacity=((0.0, 0.0), (1.0, 1.0)), *, clim=None, unit_distance=None,
@@ -221,7 +226,9 @@ def label_transfer(volume, *, colors=None, opacity=0.3, hidden=(0,), cmap="tab20
     hidden : iterable of int, default (0,)
         Labels drawn fully transparent (the background).
     cmap : str, default "tab20"
-        Qualitative colormap giving label ``i`` (the i-th label present) its colour.
+        Colormap for the labels: a qualitative one (fewer than 256 listed colours: tab10,
+        tab20, Set1, ...) gives the i-th label present its i-th colour, cycling; a continuous
+        one (viridis, ...) spreads the labels over its range.
     unit_distance : float, optional
         As :func:`colormap` (default the smallest voxel spacing).
 
@@ -246,8 +253,14 @@ def label_transfer(volume, *, colors=None, opacity=0.3, hidden=(0,), cmap="tab20
     if unknown:
         raise ValueError(f"colors names label(s) {unknown} that the volume does not hold; its "
                          f"labels: {labels.tolist()[:30]}")
-    palette = _colors(cmap, (np.arange(labels.size) % 20 + 0.5) / 20
-                      if cmap == "tab20" else np.linspace(0, 1, labels.size))
+    import matplotlib.colors as mcolors
+
+    table = _colormap(cmap)
+    if isinstance(table, mcolors.ListedColormap) and table.N < 256:  # qualitative: in turn
+        palette = np.asarray(table.colors, dtype=np.float64)[np.arange(labels.size)
+                                                            % len(table.colors), :3]
+    else:
+        palette = _colors(table, np.linspace(0, 1, labels.size))
     alphas = {int(k): v for k, v in opacity.items()} if isinstance(opacity, dict) else {}
     default = 0.3 if isinstance(opacity, dict) else opacity
     table_rgb, table_alpha = [], []

@@ -124,14 +124,14 @@ class Image:
         bg = validate.vector3("background", background)
         return self.rgba[..., :3] + (1.0 - self.rgba[..., 3:4]) * bg
 
-    def to_png(self, *, bits=8, background=(0.0, 0.0, 0.0)):
-        """The image as PNG bytes (composited over ``background``, or RGBA with straight
-        alpha when it is None), as :meth:`save` writes them.
+    def quantised(self, *, bits=8, background=(0.0, 0.0, 0.0)):
+        """Integer pixels of ``bits`` bits: RGB composited over ``background``, or RGBA with
+        straight alpha when it is None (what :meth:`save` and :func:`vrlib.turntable` write).
 
         Examples
         --------
-        >>> Image(np.full((2, 2, 4), 0.25)).to_png()[:4]
-        b'\\x89PNG'
+        >>> Image(np.full((1, 1, 4), 0.25)).quantised()[0, 0].tolist()
+        [64, 64, 64]
         """
         if bits not in (8, 16):
             raise ValueError(f"bits must be 8 or 16, got {bits!r}")
@@ -141,7 +141,17 @@ class Image:
             pixels = self.composited(background)
         top = (1 << bits) - 1
         dtype = np.uint8 if bits == 8 else np.uint16
-        return encode_png(np.round(np.clip(pixels, 0.0, 1.0) * top).astype(dtype))
+        return np.round(np.clip(pixels, 0.0, 1.0) * top).astype(dtype)
+
+    def to_png(self, *, bits=8, background=(0.0, 0.0, 0.0)):
+        """The image as PNG bytes (:meth:`quantised`), as :meth:`save` writes them.
+
+        Examples
+        --------
+        >>> Image(np.full((2, 2, 4), 0.25)).to_png()[:4]
+        b'\\x89PNG'
+        """
+        return encode_png(self.quantised(bits=bits, background=background))
 
     def _repr_png_(self):
         """Jupyter shows an image as its PNG (over black)."""

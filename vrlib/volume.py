@@ -13,6 +13,7 @@ import numpy as np
 from scipy import ndimage
 
 from vrlib import validate
+from vrlib.holes import hole_value
 
 __all__ = ["Volume", "MinMaxPyramid", "DEFAULT_EXTENT", "check_extent", "fitted_extent",
            "lattice_extent", "storage_dtype"]
@@ -169,8 +170,6 @@ class Volume:
                                  f"sample(s){hint}")
             if holes.all():
                 raise ValueError("volume data are all NaN: there is nothing to render")
-            from vrlib.holes import hole_value
-
             valid = arr[~holes]
             self._range = (float(valid.min()), float(valid.max()))
             if not copy or arr.base is not None:
@@ -242,8 +241,6 @@ class Volume:
         """The value stored in place of each hole (None without holes)."""
         if self._holes is None:
             return None
-        from vrlib.holes import hole_value
-
         return hole_value(*self.value_range)
 
     @property
