@@ -20,6 +20,7 @@ import numpy as np
 from vrlib._kernels import projection as _kernel
 from vrlib.image import Image, RenderStats
 from vrlib.prefilter import Tally, prepared
+from vrlib.raycast import operations_per_sample
 
 __all__ = ["render_projection", "BLENDS"]
 
@@ -58,7 +59,9 @@ def render_projection(volume, view, *, filt, transfer, step, blend):
     rgba = np.concatenate([transfer.emission(value) * alpha[..., None], alpha[..., None]],
                           axis=-1)
     taken = int(samples.sum())
-    stats = RenderStats(samples=taken, operations=taken * (6 + 30 * filt.taps + 2 * (
-        filt.taps ** 3 + filt.taps ** 2)), bytes=int(volume.data.nbytes + rgba.nbytes),
-        seconds=time.perf_counter() - start)
+    # Per sample: the ray caster's position and reconstruction; a max or sum in place of
+    # its classification and compositing.
+    stats = RenderStats(samples=taken, operations=taken * operations_per_sample(filt),
+                        bytes=int(volume.data.nbytes + rgba.nbytes),
+                        seconds=time.perf_counter() - start)
     return Image(rgba, tally.finish(stats, filt))
