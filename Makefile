@@ -53,10 +53,13 @@ results: $(RESULTS) $(VERDICTS)
 # The report's verdict on each thesis claim comes from its claim tests (tests/claims): each
 # test is marked as supporting, refuting or going beyond a claim. A failing test is recorded,
 # not hidden: its claim's verdict changes.
-$(VERDICTS): $(wildcard tests/claims/*.py) $(LIBRARY) $(INSTALLED)
+# docs/claim_tables.py turns the verdicts into the report's claim tables (figures/claims/).
+$(VERDICTS): $(wildcard tests/claims/*.py) tests/claim_verdicts.py docs/claim_tables.py \
+		$(LIBRARY) $(INSTALLED)
 	@mkdir -p $(@D)
 	VRLIB_VERDICTS=$@ $(PY) -m pytest -q tests/claims || echo "claim tests failed: see the verdicts"
 	@test -s $@
+	$(PY) docs/claim_tables.py $@ figures/claims
 
 # run_* scripts compute and write build/results/<chapter>/...; chapters/<chapter>/_*.py are
 # helpers shared by a chapter's scripts.

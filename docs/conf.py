@@ -20,16 +20,24 @@ extensions = [
     "sphinx.ext.autodoc",
     "sphinx.ext.napoleon",
     "sphinx.ext.mathjax",
+    # MathJax copied into the report (_static/mathjax), so formulas render with no network
+    "sphinx-mathjax-offline",
 ]
 myst_enable_extensions = ["dollarmath", "substitution"]
+myst_heading_anchors = 3  # links such as derivations.md#the-two-pass-shear
 napoleon_google_docstring = False
 napoleon_numpy_docstring = True
 autodoc_member_order = "bysource"
 autodoc_typehints = "none"
 exclude_patterns = ["_build"]
-html_theme = "alabaster"
+# furo: a wide content column for the claim and result tables, readable offline (no fonts
+# or scripts fetched from the network).
+html_theme = "furo"
 html_title = "vrlib report"
-html_theme_options = {"description": "Volume reconstruction and parallel rendering, measured"}
+html_static_path = ["_static"]
+html_css_files = ["report.css"]
+# A figure given a width (every figure in the chapters) links to its full-size file.
+html_scaled_image_link = True
 
 
 def _load_results():
@@ -46,3 +54,9 @@ myst_substitutions = _load_results()
 # numpydoc types such as "array_like, shape (n, 3)" make napoleon look up "shape", which several
 # classes define as a property; those ambiguous look-ups are not broken links.
 suppress_warnings = ["ref.python"]
+
+
+def setup(app):
+    # SVG output draws glyphs as paths: no web fonts to load, which browsers may refuse over
+    # file://. Set here, after sphinx-mathjax-offline has pointed MathJax at its bundled copy.
+    app.config.mathjax_path = "mathjax/tex-svg.js"

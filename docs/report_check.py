@@ -1,11 +1,24 @@
-"""Check the built report in a real browser: ``python docs/report_check.py build/report/html``.
+"""Check the built report in a real browser, offline: ``python docs/report_check.py build/report/html``.
 
-Every page is rendered by headless Chromium (Debian's ``chromium``) to a PNG screenshot, which
-must not be blank; every image a page refers to must exist and decode. Prints one line per
-page and exits 1 if any page fails. Screenshots are kept under ``build/report/screenshots``.
+Every page is opened by headless Chromium (Debian's ``chromium``) with the network shut off
+(every request goes to a closed local proxy), as a reader without a connection would see it.
+A page fails when:
+
+- its screenshot is blank, or an image it shows is missing or does not decode;
+- it loads a script, style sheet or font from a network address;
+- raw TeX shows in its rendered text (``\\(``, ``$$``, ``\\frac`` ... outside code), or MathJax
+  reports an error in a formula;
+- an image is shown at less than half its own width without a link to the full-size file;
+- a table is wider than the text column it sits in.
+
+The layout checks run inside the page: a copy of it with a small probe script is opened and
+the probe's findings read back from the rendered DOM (``--dump-dom``). Prints one line per page
+and exits 1 if any page fails. Screenshots are kept under ``build/report/screenshots``.
 """
 
 import html.parser
+import json
+import re
 import shutil
 import subprocess
 import sys
@@ -15,16 +28,73 @@ import imageio.v3 as iio
 import numpy as np
 
 SKIP = {"genindex.html", "search.html", "py-modindex.html"}
+WINDOW = (1280, 2000)
+OFFLINE = ["--proxy-server=http://127.0.0.1:9", "--proxy-bypass-list=<-loopback>"]
+# Long enough for MathJax to typeset the longest page (virtual time: it passes as fast as the
+# page lets it).
+BUDGET_MS = 20000
+
+# Runs in the page once it has loaded and MathJax (if any) has typeset; writes its findings
+# as JSON into a <pre id="vrlib-probe">.
+PROBE = r"""
+<script>
+window.addEventListener("load", async () => {
+  if (window.MathJax && MathJax.startup && MathJax.startup.promise) {
+    try { await MathJax.startup.promise; } catch (e) {}
+  }
+  const out = {tex: [], mathErrors: 0, images: [], tables: [], mathjax: !!(window.MathJax &&
+               MathJax.version)};
+  const raw = /\\\(|\\\)|\\\[|\\\]|\$\$|\\(frac|mathrm|mathbf|sum|int|sqrt|sigma|alpha|omega|le|ge|cdot|times|text)\b|\$[^$\s][^$]*[^$\s\\]\$/;
+  const code = "pre, code, script, style, mjx-container, .highlight, textarea, #vrlib-probe";
+  const walker = document.createTreeWalker(document.body, NodeFilter.SHOW_TEXT);
+  for (let node = walker.nextNode(); node; node = walker.nextNode()) {
+    const parent = node.parentElement;
+    if (!parent || parent.closest(code) || !parent.getClientRects().length) continue;
+    const text = node.textContent;
+    if (raw.test(text)) out.tex.push(text.trim().slice(0, 80));
+  }
+  out.mathErrors = document.querySelectorAll("mjx-merror, .MathJax_Error").length;
+  const column = document.querySelector("article") || document.querySelector("[role=main]") ||
+                 document.body;
+  const right = column.getBoundingClientRect().right;
+  for (const img of column.querySelectorAll("img")) {
+    const shown = img.getBoundingClientRect().width;
+    if (img.naturalWidth > 0 && shown < img.naturalWidth / 2 && !img.closest("a[href]")) {
+      out.images.push(`${img.getAttribute("src")} (${Math.round(shown)} of ${img.naturalWidth} px)`);
+    }
+  }
+  for (const table of column.querySelectorAll("table")) {
+    const box = table.getBoundingClientRect();
+    if (box.right > right + 1 || table.scrollWidth > column.clientWidth + 1) {
+      const caption = table.querySelector("caption");
+      out.tables.push(`${caption ? caption.textContent.trim().slice(0, 60) : "a table"} ` +
+                      `(${Math.round(box.width)} px in a ${column.clientWidth} px column)`);
+    }
+  }
+  const pre = document.createElement("pre");
+  pre.id = "vrlib-probe";
+  pre.textContent = JSON.stringify(out);
+  document.body.appendChild(pre);
+});
+</script>
+"""
 
 
-class Images(html.parser.HTMLParser):
+class Resources(html.parser.HTMLParser):
+    """The images a page shows and the network addresses it loads from."""
+
     def __init__(self):
         super().__init__()
-        self.sources = []
+        self.images, self.remote = [], []
 
     def handle_starttag(self, tag, attrs):
+        attrs = dict(attrs)
         if tag == "img":
-            self.sources.append(dict(attrs).get("src", ""))
+            self.images.append(attrs.get("src", ""))
+        source = attrs.get("src") if tag in ("script", "img") else (
+            attrs.get("href") if tag == "link" else None)
+        if source and re.match(r"(https?:)?//", source):
+            self.remote.append(source)
 
 
 def browser():
@@ -35,18 +105,31 @@ def browser():
     raise SystemExit("report-check needs Chromium: apt-get install chromium")
 
 
-def screenshot(chrome, page, out):
-    subprocess.run([chrome, "--headless", "--no-sandbox", "--disable-gpu", "--hide-scrollbars",
-                    "--window-size=1280,2000", f"--screenshot={out}", page.as_uri()],
-                   capture_output=True, timeout=120, check=False)
-    return out.exists() and out.stat().st_size > 0
+def chrome_run(chrome, *args):
+    return subprocess.run([chrome, "--headless", "--no-sandbox", "--disable-gpu",
+                           "--hide-scrollbars", f"--window-size={WINDOW[0]},{WINDOW[1]}",
+                           f"--virtual-time-budget={BUDGET_MS}", *OFFLINE, *args],
+                          capture_output=True, text=True, timeout=180, check=False)
 
 
-def check_page(chrome, page, name, shots):
+def probe(chrome, page):
+    """What the probe script found on ``page`` (None if the browser gave no answer)."""
+    copy = page.with_name(f".probe-{page.name}")
+    text = page.read_text(encoding="utf-8")
+    copy.write_text(text.replace("</body>", PROBE + "</body>", 1), encoding="utf-8")
+    try:
+        dom = chrome_run(chrome, "--dump-dom", copy.as_uri()).stdout
+    finally:
+        copy.unlink()
+    found = re.search(r'<pre id="vrlib-probe">(.*?)</pre>', dom, flags=re.S)
+    if not found:
+        return None
+    return json.loads(html.unescape(found.group(1)))
+
+
+def check_images(page, sources):
     problems = []
-    parser = Images()
-    parser.feed(page.read_text(encoding="utf-8"))
-    for src in parser.sources:
+    for src in sources:
         if src.startswith(("http:", "https:", "data:")):
             continue
         target = (page.parent / src.split("#")[0]).resolve()
@@ -60,20 +143,43 @@ def check_page(chrome, page, name, shots):
             continue
         if pixels.size == 0:
             problems.append(f"empty image {src}")
+    return problems
+
+
+def check_page(chrome, page, name, shots):
+    resources = Resources()
+    resources.feed(page.read_text(encoding="utf-8"))
+    problems = check_images(page, resources.images)
+    problems += [f"loads {url} from the network" for url in resources.remote]
+    found = probe(chrome, page)
+    if found is None:
+        problems.append("the browser returned no layout probe")
+    else:
+        if found["tex"]:
+            problems.append(f"raw TeX in the text: {found['tex'][:3]}")
+        if found["mathErrors"]:
+            problems.append(f"{found['mathErrors']} formula(s) MathJax could not typeset")
+        if found["images"]:
+            problems.append(f"image shown at under half its width with no link: {found['images']}")
+        if found["tables"]:
+            problems.append(f"table wider than the text column: {found['tables']}")
     out = shots / (name.replace("/", "-").removesuffix(".html") + ".png")
-    if not screenshot(chrome, page, out):
+    out.unlink(missing_ok=True)
+    chrome_run(chrome, f"--screenshot={out}", page.as_uri())
+    if not (out.exists() and out.stat().st_size > 0):
         problems.append("the browser made no screenshot")
     else:
         shot = iio.imread(out)[..., :3].astype(float)
         inked = np.mean(np.abs(shot - shot[0, 0]).sum(axis=-1) > 30)
         if inked < 0.01:
             problems.append(f"blank page ({100 * inked:.2f}% of pixels drawn)")
-    return len(parser.sources), problems
+    return len(resources.images), problems
 
 
 def main(root):
     root = Path(root).resolve()
     pages = sorted(p for p in root.rglob("*.html") if p.name not in SKIP
+                   and not p.name.startswith(".")
                    and "_modules" not in p.parts and "_static" not in p.parts)
     if not pages:
         raise SystemExit(f"no pages under {root}: build the report first (make report)")
@@ -85,8 +191,9 @@ def main(root):
         images, problems = check_page(chrome, page, str(page.relative_to(root)), shots)
         status = "ok" if not problems else "FAIL: " + "; ".join(problems)
         failed += bool(problems)
-        print(f"{page.relative_to(root)}: {images} images, {status}")
-    print(f"{len(pages) - failed} of {len(pages)} pages pass; screenshots in {shots}")
+        print(f"{page.relative_to(root)}: {images} images, {status}", flush=True)
+    print(f"{len(pages) - failed} of {len(pages)} pages pass (offline, "
+          f"{WINDOW[0]}x{WINDOW[1]} window); screenshots in {shots}")
     return 1 if failed else 0
 
 

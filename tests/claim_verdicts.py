@@ -73,26 +73,30 @@ def pytest_sessionfinish(session):
     target = os.environ.get("VRLIB_VERDICTS")
     if not target:
         return
-    marks = {}
+    marks, docs = {}, {}
     for item in session.items:
         mark = item.get_closest_marker("claim")
         if mark is not None:
             marks[item.nodeid] = mark.args
+            docs[item.nodeid] = " ".join((item.function.__doc__ or "").split("\n\n")[0].split())
     claims = {str(n): {"claim": text, "tests": []} for n, text in CLAIMS.items()}
     for entry in _OUTCOMES:
         if entry["nodeid"] not in marks:
             continue
         number, role = marks[entry["nodeid"]]
         claims[str(number)]["tests"].append({"test": entry["nodeid"], "role": role,
-                                             "outcome": entry["outcome"]})
+                                             "outcome": entry["outcome"],
+                                             "checks": docs[entry["nodeid"]]})
     for entry in claims.values():
         entry["verdict"] = verdict(entry["tests"])
         tests = entry["tests"]
         # Checks whose outcome says the claim (or vrlib's own version of it) holds, and
-        # checks whose outcome says a part of it does not.
-        entry["hold"] = sum((t["role"] != "refutes") == (t["outcome"] == "passed")
-                            for t in tests if t["outcome"] in ("passed", "failed"))
-        entry["fail"] = sum((t["role"] == "refutes") == (t["outcome"] == "passed")
-                            for t in tests if t["outcome"] in ("passed", "failed"))
+        # checks whose outcome says a part of it does not (named, for the report).
+        for t in tests:
+            t["holds"] = (t["role"] != "refutes") == (t["outcome"] == "passed")
+        ran = [t for t in tests if t["outcome"] in ("passed", "failed")]
+        entry["hold"] = sum(t["holds"] for t in ran)
+        entry["fail"] = len(ran) - entry["hold"]
+        entry["failing"] = [t["test"] for t in ran if not t["holds"]]
     with atomic_path(target) as tmp:
         tmp.write_text(json.dumps({"claims": claims}, indent=2, sort_keys=True) + "\n")

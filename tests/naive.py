@@ -23,13 +23,13 @@ def random_orbits(count, *, seed, size):
 
 
 def image_mass(image, view):
-    """Brief section 2: sum over pixels of -ln(1 - alpha) times the pixel's area, which equals
+    """The rendering model (docs/model.md): sum over pixels of -ln(1 - alpha) times the pixel's area, which equals
     k times the integral of the field for a Glow(k) image that sees the whole volume."""
     return float(-np.log1p(-image.alpha).sum() * view.pixel_size**2)
 
 
 def exact_blob_image(field, view, scale):
-    """Closed-form Glow image of an analytic field with exact line integrals (brief section 2):
+    """Closed-form Glow image of an analytic field with exact line integrals (docs/model.md):
     ``1 - exp(-k * line integral)``, each ray clipped to the field's box."""
     o, d = view.rays()
     t0, t1 = _clip_to_box(o, d, field.bounds[:, 0], field.bounds[:, 1])

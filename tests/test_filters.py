@@ -1,4 +1,4 @@
-"""Properties of the reconstruction filters (brief section 3)."""
+"""Properties of the reconstruction filters (docs/chapters/ch02_filters.md)."""
 
 import math
 
@@ -50,7 +50,7 @@ def test_even(spec):
 @pytest.mark.parametrize("spec", ALL, ids=str)
 def test_partition_of_unity_where_theory_says(spec):
     """Box, tent and every Mitchell-Netravali cubic sum to one over the lattice; the Gaussian
-    does not (brief section 3)."""
+    does not (docs/chapters/ch02_filters.md)."""
     f = build(spec)
     offsets = np.linspace(0.0, 1.0, 101)
     n = np.arange(-4, 5)
@@ -81,7 +81,7 @@ def test_frequency_response_matches_fft(spec):
 
 
 def test_frequency_response_at_nyquist():
-    """Values at Nyquist (brief section 3): Catmull-Rom 48/pi^4, tent 4/pi^2, Mitchell 0.383,
+    """Values at Nyquist (docs/chapters/ch02_filters.md): Catmull-Rom 48/pi^4, tent 4/pi^2, Mitchell 0.383,
     B-spline 16/pi^4."""
     at = {name: float(make_filter(name).frequency_response(np.pi)) for name in NAMED}
     assert at["catmull-rom"] == pytest.approx(48 / np.pi**4, rel=1e-12)
@@ -145,7 +145,7 @@ def test_derivative_matches_finite_difference(spec):
 
 
 def test_catmull_rom_reproduces_quadratics():
-    """Catmull-Rom is third order: it reconstructs any quadratic exactly (brief section 3)."""
+    """Catmull-Rom is third order: it reconstructs any quadratic exactly (docs/chapters/ch02_filters.md)."""
     f = make_filter("catmull-rom")
     n = np.arange(-5, 7)
     for x0 in np.linspace(0.0, 1.0, 11):

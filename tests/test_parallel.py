@@ -170,7 +170,7 @@ def test_bad_messages_are_refused():
 
 
 def test_classic_binary_swap_sends_w2_one_minus_one_over_p():
-    """Full-screen binary swap: each node sends W^2 (1 - 1/P) pixels (brief section 7)."""
+    """Full-screen binary swap: each node sends W^2 (1 - 1/P) pixels (docs/derivations.md)."""
     origin, spacing = lattice(33)
     view = View.orbit(azimuth=30, elevation=20, size=64)
     for parts in (2, 4, 8, 16):

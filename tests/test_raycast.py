@@ -110,7 +110,7 @@ def test_bricks_share_the_global_lattice():
 @pytest.mark.parametrize("filt", ["box", "trilinear", "catmull-rom", "bspline", "mitchell",
                                   "gaussian"])
 def test_glow_blob_against_closed_form(filt):
-    """A Gaussian blob sampled at 64^3 against its closed-form image (brief section 2).
+    """A Gaussian blob sampled at 64^3 against its closed-form image (docs/model.md).
 
     Measured rmse at steps 1, 0.5, 0.25 (64^3, 96^2, Glow(2), sigma 0.3, azimuth 30,
     elevation 20): box 2.0e-4 / 9.3e-5 / 8.4e-5, trilinear 9.2e-5 at every step, Catmull-Rom
@@ -132,7 +132,7 @@ def test_glow_blob_against_closed_form(filt):
 
 
 def test_mass_invariant_over_random_orbits():
-    """Sum of -ln(1 - alpha) * pixel area = k * integral of F (brief section 2), to 0.5%, for
+    """Sum of -ln(1 - alpha) * pixel area = k * integral of F (docs/model.md), to 0.5%, for
     8 random orbits, orthographic."""
     field = data_gen.make_field("gaussian-blob", sigma=0.25, center=(0.1, 0.0, -0.1))
     vol = field.sample(48)

@@ -15,10 +15,11 @@ README = ROOT / "README.md"
 VRLIB = Path(sys.executable).parent / "vrlib"
 #: The commands that made the README's pictures.
 PICTURES = {
-    "docs/images/mni152.png": "vrlib render mni152 --size 320 --zoom 1.7 --transfer "
-                              "ramp:0.3:300 --shade --azimuth 120 --elevation 15",
-    "docs/images/marschner-lobb.png": "vrlib render marschner-lobb:96 --size 320 --transfer "
-                                      "ramp:0.5:2000 --shade --elevation 30",
+    "docs/images/mni152.png": "vrlib render mni152 --size 320 --zoom 1.7 --filter catmull-rom "
+                              "--transfer ramp:0.3:300 --shade --azimuth 120 --elevation 15",
+    "docs/images/marschner-lobb.png": "vrlib render marschner-lobb:96 --size 320 --filter "
+                                      "catmull-rom --transfer ramp:0.5:2000 --shade "
+                                      "--elevation 30",
 }
 
 

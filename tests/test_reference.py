@@ -23,7 +23,7 @@ def closed_form(field, view, scale):
     ("step-edge", {"normal": (1, 1, 0), "offset": 0.1}),
 ])
 def test_glow_matches_closed_form_to_1e6(projection, name, params):
-    """Brief section 2: for a Gaussian blob under Glow the reference equals
+    """The rendering model (docs/model.md): for a Gaussian blob under Glow the reference equals
     1 - exp(-k * line integral); the same holds for every field with a closed form (the step
     edge's jump is handled by splitting the quadrature there)."""
     field = data_gen.make_field(name, **params)

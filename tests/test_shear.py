@@ -144,7 +144,7 @@ def test_glow_blob_against_closed_form(method):
 
 @pytest.mark.parametrize("method", METHODS)
 def test_mass_invariant_over_random_orbits(method):
-    """Brief section 2, to 1%, 8 random orbits."""
+    """The rendering model (docs/model.md), to 1%, 8 random orbits."""
     field = data_gen.make_field("gaussian-blob", sigma=0.25, center=(0.1, 0.0, -0.1))
     vol = field.sample(48)
     expected = 1.5 * field.integral(field.bounds)

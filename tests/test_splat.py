@@ -274,7 +274,7 @@ def test_opaque_pixels_take_nothing_more():
 @pytest.mark.parametrize("filt", ["box", "trilinear", "catmull-rom", "bspline", "mitchell",
                                   "gaussian"])
 def test_glow_blob_against_closed_form(filt):
-    """A Gaussian blob sampled at 64^3 against its closed-form image (brief section 2), both
+    """A Gaussian blob sampled at 64^3 against its closed-form image (docs/model.md), both
     modes. Measured rmse (96^2, Glow(2)): box 1.5e-4, trilinear 2.0e-4, Catmull-Rom 1.2e-4,
     B-spline 3.2e-4, Mitchell 1.7e-4, Gaussian 3.3e-4: the sampling and the footprint tables
     set the floor."""
@@ -289,7 +289,7 @@ def test_glow_blob_against_closed_form(filt):
 
 @pytest.mark.parametrize("sigma", [0.4, 0.5, 0.6, 0.7])
 def test_gaussian_ripple_floor(sigma):
-    """A Gaussian kernel does not sum to one over the lattice (brief section 3): splatting a
+    """A Gaussian kernel does not sum to one over the lattice (docs/chapters/ch02_filters.md): splatting a
     constant volume along an axis gives an image that ripples with the lattice, by
     2 exp(-2 pi^2 sigma^2) per axis (brief: 1.4% at sigma 0.5, 0.16% at 0.6), so by twice that
     over the two axes of the image. Measured (ptp / 2 / mean): 16.6%, 2.82%, 0.322%, 0.022%

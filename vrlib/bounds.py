@@ -3,8 +3,8 @@
 The feature is a Gaussian ``f(x) = exp(-x^2 / (2 sigma^2))`` sampled at spacing ``h`` with an
 arbitrary grid offset and reconstructed with a filter ``k``: ``R(x) = sum_n f(x_n) k(x - x_n)``.
 Its error ``E(sigma / h)`` is the worst case over position and grid offset of
-``|R(x) - f(x)| / f(0)`` (the thesis's scale-space idea, chapter 1; the construction is the
-project brief's, section 5). Two numbers per filter and ratio:
+``|R(x) - f(x)| / f(0)`` (the thesis's scale-space idea, chapter 1; the construction is derived in
+docs/derivations.md). Two numbers per filter and ratio:
 
 * :func:`feature_error` measures it: a dense search over positions and offsets in 1-D, and in
   3-D the exact worst case over the product of the 1-D searches (see its notes).

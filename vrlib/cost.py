@@ -7,7 +7,7 @@ shearing) or of a slice on the intermediate image (shear-warp). Every renderer c
 points and operations in :class:`vrlib.RenderStats` (``points``, ``operations``), so a new
 renderer needs nothing here.
 
-The model (the thesis's question, the brief's section 6): a frame costs
+The model (the thesis's question, docs/derivations.md): a frame costs
 ``t = c_op * operations + c_pt * points + c_0``, with per-machine constants fitted to
 measured frames by :func:`fit_model`; :func:`measure` times a render and records the machine
 beside it, so that measurements from several machines can be merged.

@@ -57,7 +57,9 @@ def render(volume, view, *, method="raycast", filter="trilinear", transfer=None,
     method : {"raycast", "splat", "shear3", "shear2", "shearwarp"}
         The rendering method (see :data:`METHODS`).
     filter : str, tuple or Filter, default "trilinear"
-        Reconstruction filter, by name or built with :func:`vrlib.make_filter`. A prefiltered
+        Reconstruction filter, by name or built with :func:`vrlib.make_filter`. Trilinear is
+        the default here and on the command line because it is the fastest; ``"catmull-rom"``
+        is more accurate (the report's chapter 3) and slower (chapter 4 times both). A prefiltered
         filter (``"cardinal-bspline"``, ``"omoms"``) reconstructs spline coefficients with its
         kernel, in every method (:mod:`vrlib.prefilter` says which axes each prefilters; the
         volume's coefficients are kept with it); ``stats.prefilter`` says what it cost.

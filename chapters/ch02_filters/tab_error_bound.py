@@ -1,5 +1,5 @@
-"""Tables: the worst-case error at the brief's feature sizes (measured 1-D and 3-D, the Fourier
-bound, the brief's derived prediction), and the feature size each filter needs for 10%, 5% and
+"""Tables: the worst-case error at the derived predictions' feature sizes (measured 1-D and 3-D, the Fourier
+bound, the derived prediction), and the feature size each filter needs for 10%, 5% and
 1% error."""
 
 import math
@@ -13,16 +13,16 @@ def _ratio(value):
 
 def main():
     data = read_json(result_path(__file__, "error_bound.json"))
-    ratios = data["brief_ratios"]
+    ratios = data["derived_ratios"]
     rows = []
-    for label, s in data["at_brief"].items():
-        brief = s["brief_1d"] or [None] * len(ratios)
+    for label, s in data["at_derived"].items():
+        derived = s["derived_1d"] or [None] * len(ratios)
         for q, m1, m3, b1, p in zip(ratios, s["measured_1d"], s["measured_3d"], s["bound_1d"],
-                                    brief, strict=True):
+                                    derived, strict=True):
             rows.append([label, f"{q:g}", f"{m1:.3f}", "-" if p is None else f"{p:.3f}",
                          "inf" if math.isinf(b1) else f"{b1:.3f}", f"{m3:.3f}"])
     write_csv(figure_path(__file__, "error_bound.csv"),
-              ["filter", "sigma/h", "E 1-D measured", "E 1-D brief [D]", "Fourier bound 1-D",
+              ["filter", "sigma/h", "E 1-D measured", "E 1-D derived", "Fourier bound 1-D",
                "E 3-D measured"], rows)
     targets = [f"{t:g}" for t in data["targets"]]
     rows = [[label] + [_ratio(r[t][dims]) for t in targets for dims in ("1d", "3d")]

@@ -3,7 +3,7 @@
 import matplotlib.pyplot as plt
 import numpy as np
 
-from chapters.ch05_shear._saving import ratios
+from chapters.ch05_shear._saving import PREDICTED, ratios
 from chapters.common import figure_path, read_json, result_path, save_figure
 
 
@@ -13,15 +13,14 @@ def main():
     fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.2))
     names = list(out)
     left.boxplot([out[n] for n in names], tick_labels=names, widths=0.5)
-    for x, (lo, hi) in enumerate([(0.63, 0.63), (0.65, 0.72), (0.65, 0.72), (0.67, 0.67)],
-                                 start=1):
+    for x, (lo, hi) in enumerate((PREDICTED[n] for n in names), start=1):
         left.plot([x - 0.3, x + 0.3], [lo, lo], color="C3", lw=1.5)
         if hi != lo:
             left.plot([x - 0.3, x + 0.3], [hi, hi], color="C3", lw=1.5)
     left.axhline(1.0, color="0.6", lw=0.8, ls=":")
     left.set_ylabel("two-pass / three-pass")
     left.set_title(f"{len(data['rotations'])} random rotations, {data['N']}$^3$ "
-                   "(red: brief's predictions)", fontsize=10)
+                   "(red: derived predictions)", fontsize=10)
     elevation = np.array([r["elevation"] for r in data["rotations"]])
     for method, marker in (("shear3", "o"), ("shear2", "s")):
         right.scatter(np.abs(elevation), per_n3[method], s=14, marker=marker, label=method)

@@ -18,7 +18,7 @@ def chords(view, lo, hi):
 
 def glow_image(field, view, scale, extent=None):
     """Glow image ``1 - exp(-k * line integral)`` of a field with an exact line integral
-    (brief section 2), each ray clipped to ``extent`` (default the field's box)."""
+    (docs/model.md), each ray clipped to ``extent`` (default the field's box)."""
     box = field.bounds if extent is None else np.asarray(extent, float)
     t0, t1, o, d = chords(view, box[:, 0], box[:, 1])
     return -np.expm1(-scale * field.line_integral(o, d, t0, t1))

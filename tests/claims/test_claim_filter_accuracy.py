@@ -61,8 +61,9 @@ def test_a_truncated_gaussian_has_an_error_floor_the_cubic_does_not():
 @pytest.mark.claim(1, "beyond")
 @pytest.mark.parametrize("dims", [1, 3])
 def test_prefiltered_cubics_have_a_lower_worst_case_error_than_catmull_rom(dims):
-    """At every feature size of the brief, measured and bounded, in 1-D and 3-D; O-MOMS lowest
-    (ch02: at sigma/h = 1 in 1-D, 0.048 Catmull-Rom, 0.020 cardinal B-spline, 0.012 O-MOMS)."""
+    """At every feature size of the derived predictions (docs/derivations.md), measured and
+    bounded, in 1-D and 3-D; O-MOMS lowest (ch02: at sigma/h = 1 in 1-D, 0.048 Catmull-Rom,
+    0.020 cardinal B-spline, 0.012 O-MOMS)."""
     for ratio in RATIOS:
         cubic = bounds.feature_error("catmull-rom", ratio, dims=dims)
         spline, omoms = (bounds.feature_error(f, ratio, dims=dims) for f in PREFILTERED)

@@ -1,4 +1,4 @@
-"""The analytic model of a frame's communication (brief section 7, derived there; tested here
+"""The analytic model of a frame's communication (docs/derivations.md, derived there; tested here
 against :mod:`vrlib.parallel.traffic` routed on :mod:`vrlib.parallel.network`).
 
 Notation: a cube volume of side ``L`` world units with ``N^3`` samples, a ``W x W`` image of
@@ -60,7 +60,7 @@ def object_frame(grid, *, side, pixel, bytes_per_pixel=4, view=None):
     bricks, one per node.
 
     Each node sends its local image, less the share that falls on its own tile (``1/P``).
-    The local image is the mean projected area (``view`` None: Cauchy, the brief's slab
+    The local image is the mean projected area (``view`` None: Cauchy, the derived slab
     ``W^2 / 2``, shaft ``W^2 / sqrt(P)``, block ``1.5 W^2 / P^(2/3)`` when the image spans
     the volume), or the bounding rectangle of the box's projection for ``view``.
 
@@ -120,7 +120,7 @@ def image_dynamic_frame(nodes, samples, *, dtheta, depth, tile_width, pixel,
     about the image's vertical axis shifts a voxel at depth offset ``z`` by ``z dtheta``; with
     ``z`` uniform over a volume ``depth`` deep, the mean shift is ``depth dtheta / 4``, and a
     voxel changes tile with probability shift / ``tile_width`` (pixels). With the image
-    spanning the volume (``tile_width = W / sqrt(P)``) this is the brief's
+    spanning the volume (``tile_width = W / sqrt(P)``) this is the derived
     ``N^3 dtheta / (4 sqrt(P))`` per node.
 
     Returns bytes ``(per_node, total)``.
@@ -161,7 +161,7 @@ def channel_loads(total, nodes, *, torus=False):
 
     Returns a dict: ``mean`` (total x mean hops / channels) and ``bisection`` (half the
     traffic crosses the middle cut, half of that each way, over its ``2 Y`` directed
-    channels, ``4 Y`` on a torus). The brief counts a link's two directions together, which
+    channels, ``4 Y`` on a torus). The derivation counts a link's two directions together, which
     doubles its figures against these.
 
     Examples
