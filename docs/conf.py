@@ -34,8 +34,6 @@ exclude_patterns = ["_build"]
 # or scripts fetched from the network).
 html_theme = "furo"
 html_title = "vrlib report"
-html_static_path = ["_static"]
-html_css_files = ["report.css"]
 # A figure given a width (every figure in the chapters) links to its full-size file.
 html_scaled_image_link = True
 
