@@ -59,7 +59,7 @@ $(VERDICTS): $(wildcard tests/claims/*.py) tests/claim_verdicts.py docs/claim_ta
 	@mkdir -p $(@D)
 	VRLIB_VERDICTS=$@ $(PY) -m pytest -q tests/claims || echo "claim tests failed: see the verdicts"
 	@test -s $@
-	$(PY) docs/claim_tables.py $@ figures/claims
+	$(PY) -m docs.claim_tables $@ figures/claims
 
 # run_* scripts compute and write build/results/<chapter>/...; chapters/<chapter>/_*.py are
 # helpers shared by a chapter's scripts.

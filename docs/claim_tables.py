@@ -1,5 +1,5 @@
 """The report's claim tables, from the verdicts of the claim tests:
-``python docs/claim_tables.py build/results/claims/verdicts.json figures/claims``.
+``python -m docs.claim_tables build/results/claims/verdicts.json figures/claims``.
 
 Writes ``claims.csv`` (the front page's table: each claim, its verdict with the checks that do
 not hold named, and links to its chapters, figures and tests) and ``claim_<n>.csv`` (every test
@@ -8,14 +8,12 @@ Markdown, so the links work in the report. Then compares the README's verdict ta
 verdicts and says which rows differ (a warning: the README is updated by hand, at a commit).
 """
 
-import csv
-import io
 import json
 import re
 import sys
 from pathlib import Path
 
-from vrlib.atomic import atomic_path
+from chapters.common import write_csv
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -24,7 +22,8 @@ ROOT = Path(__file__).resolve().parent.parent
 CLAIMS = {
     "1": ("A separable cubic filter reconstructs more accurately than a pyramid (trilinear) or "
           "a Gaussian filter, by image comparison and by an analytic scale-space error bound.",
-          [("Filters", "chapters/ch02_filters.md"), ("Image accuracy", "chapters/ch03_accuracy.md")],
+          [("Filters", "chapters/ch02_filters.md"),
+           ("Image accuracy", "chapters/ch03_accuracy.md")],
           ["ch02_filters/error_bound.png", "ch03_accuracy/filter_ranking.csv"]),
     "2": ("Splatting is the most efficient reconstruction method per reconstructed point.",
           [("Cost", "chapters/ch04_cost.md")],
@@ -65,13 +64,6 @@ def evidence_cell(number, chapters, figures):
     pages = ", ".join(f"[{title}]({page})" for title, page in chapters)
     files = ", ".join(f"[{Path(f).name}](../figures/{f})" for f in figures)
     return f"{pages}; {files}; [the tests](claim_tests.md#claim-{number})"
-
-
-def write_csv(path, header, rows):
-    buffer = io.StringIO()
-    csv.writer(buffer, lineterminator="\n").writerows([header, *rows])
-    with atomic_path(path) as tmp:
-        tmp.write_text(buffer.getvalue())
 
 
 def readme_differences(claims, readme):

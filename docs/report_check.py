@@ -1,4 +1,5 @@
-"""Check the built report in a real browser, offline: ``python docs/report_check.py build/report/html``.
+"""Check the built report in a real browser, offline:
+``python docs/report_check.py build/report/html``.
 
 Every page is opened by headless Chromium (Debian's ``chromium``) with the network shut off
 (every request goes to a closed local proxy), as a reader without a connection would see it.
@@ -44,7 +45,9 @@ window.addEventListener("load", async () => {
   }
   const out = {tex: [], mathErrors: 0, images: [], tables: [], mathjax: !!(window.MathJax &&
                MathJax.version)};
-  const raw = /\\\(|\\\)|\\\[|\\\]|\$\$|\\(frac|mathrm|mathbf|sum|int|sqrt|sigma|alpha|omega|le|ge|cdot|times|text)\b|\$[^$\s][^$]*[^$\s\\]\$/;
+  const commands = "frac|mathrm|mathbf|sum|int|sqrt|sigma|alpha|omega|le|ge|cdot|times|text";
+  const raw = new RegExp(String.raw`\\\(|\\\)|\\\[|\\\]|\$\$|\\(${commands})\b|` +
+                         String.raw`\$[^$\s][^$]*[^$\s\\]\$`);
   const code = "pre, code, script, style, mjx-container, .highlight, textarea, #vrlib-probe";
   const walker = document.createTreeWalker(document.body, NodeFilter.SHOW_TEXT);
   for (let node = walker.nextNode(); node; node = walker.nextNode()) {
@@ -60,7 +63,8 @@ window.addEventListener("load", async () => {
   for (const img of column.querySelectorAll("img")) {
     const shown = img.getBoundingClientRect().width;
     if (img.naturalWidth > 0 && shown < img.naturalWidth / 2 && !img.closest("a[href]")) {
-      out.images.push(`${img.getAttribute("src")} (${Math.round(shown)} of ${img.naturalWidth} px)`);
+      const size = `${Math.round(shown)} of ${img.naturalWidth} px`;
+      out.images.push(`${img.getAttribute("src")} (${size})`);
     }
   }
   for (const table of column.querySelectorAll("table")) {

@@ -23,8 +23,9 @@ def random_orbits(count, *, seed, size):
 
 
 def image_mass(image, view):
-    """The rendering model (docs/model.md): sum over pixels of -ln(1 - alpha) times the pixel's area, which equals
-    k times the integral of the field for a Glow(k) image that sees the whole volume."""
+    """The rendering model (docs/model.md): sum over pixels of -ln(1 - alpha) times the pixel's
+    area, which equals k times the integral of the field for a Glow(k) image that sees the
+    whole volume."""
     return float(-np.log1p(-image.alpha).sum() * view.pixel_size**2)
 
 

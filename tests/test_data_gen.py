@@ -50,8 +50,8 @@ def test_line_integrals_match_quadrature(name, params):
 
 
 def test_blob_closed_forms():
-    """The rendering model (docs/model.md): line integral A s sqrt(2 pi) exp(-r^2 / 2 s^2), total mass
-    A (2 pi)^(3/2) s^3."""
+    """The rendering model (docs/model.md): line integral A s sqrt(2 pi) exp(-r^2 / 2 s^2),
+    total mass A (2 pi)^(3/2) s^3."""
     blob = make_field("gaussian-blob", center=(0.2, 0.0, 0.0), sigma=0.3, amplitude=1.5)
     r = 0.35
     line = blob.line_integral([0.2 + r, 0.0, -10.0], [0, 0, 1])

@@ -81,8 +81,8 @@ def test_frequency_response_matches_fft(spec):
 
 
 def test_frequency_response_at_nyquist():
-    """Values at Nyquist (docs/chapters/ch02_filters.md): Catmull-Rom 48/pi^4, tent 4/pi^2, Mitchell 0.383,
-    B-spline 16/pi^4."""
+    """Values at Nyquist (docs/chapters/ch02_filters.md): Catmull-Rom 48/pi^4, tent 4/pi^2,
+    Mitchell 0.383, B-spline 16/pi^4."""
     at = {name: float(make_filter(name).frequency_response(np.pi)) for name in NAMED}
     assert at["catmull-rom"] == pytest.approx(48 / np.pi**4, rel=1e-12)
     assert at["pyramid"] == pytest.approx(4 / np.pi**2, rel=1e-12)
@@ -104,12 +104,13 @@ def test_gaussian_ripple_follows_poisson_summation():
     about 1 is ``2 K(2 pi) = 2 exp(-2 pi^2 sigma^2)`` for a barely truncated Gaussian (radius
     8 sigma keeps the truncation jump, whose spectrum decays slowly, below 1e-13).
 
-    The brief predicts 1.4% at sigma 0.5, 0.16% at 0.6 and 0.02% at 0.7: measured 1.44%,
-    0.164% and 0.0126%. The last is 0.01%, not 0.02%: the brief's figure is rounded up.
+    The rounded values 1.4% at sigma 0.5 and 0.16% at 0.6 (docs/derivations.md) are checked to
+    5%: measured 1.44% and 0.164%; at 0.7 the ripple is 0.0126% (a rounded 0.02% would be
+    wrong by 60%).
     """
     x = np.linspace(0.0, 1.0, 201)
     n = np.arange(-7, 8)
-    for sigma, brief in [(0.5, 0.014), (0.6, 0.0016), (0.7, None)]:
+    for sigma, rounded in [(0.5, 0.014), (0.6, 0.0016), (0.7, None)]:
         f = make_filter("gaussian", sigma=sigma, radius=8 * sigma)
         total = f(x[:, None] - n[None, :]).sum(axis=1)
         m = np.arange(1, 6)
@@ -119,8 +120,8 @@ def test_gaussian_ripple_follows_poisson_summation():
         np.testing.assert_allclose(total, series, atol=1e-12)
         ripple = np.ptp(total) / 2
         assert ripple == pytest.approx(2 * np.exp(-2 * np.pi**2 * sigma**2), rel=1e-3)
-        if brief is not None:
-            assert ripple == pytest.approx(brief, rel=0.05)
+        if rounded is not None:
+            assert ripple == pytest.approx(rounded, rel=0.05)
         else:
             assert ripple == pytest.approx(1.26e-4, rel=0.02)
 
@@ -145,7 +146,8 @@ def test_derivative_matches_finite_difference(spec):
 
 
 def test_catmull_rom_reproduces_quadratics():
-    """Catmull-Rom is third order: it reconstructs any quadratic exactly (docs/chapters/ch02_filters.md)."""
+    """Catmull-Rom is third order: it reconstructs any quadratic exactly
+    (docs/chapters/ch02_filters.md)."""
     f = make_filter("catmull-rom")
     n = np.arange(-5, 7)
     for x0 in np.linspace(0.0, 1.0, 11):

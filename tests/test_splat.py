@@ -289,9 +289,9 @@ def test_glow_blob_against_closed_form(filt):
 
 @pytest.mark.parametrize("sigma", [0.4, 0.5, 0.6, 0.7])
 def test_gaussian_ripple_floor(sigma):
-    """A Gaussian kernel does not sum to one over the lattice (docs/chapters/ch02_filters.md): splatting a
-    constant volume along an axis gives an image that ripples with the lattice, by
-    2 exp(-2 pi^2 sigma^2) per axis (brief: 1.4% at sigma 0.5, 0.16% at 0.6), so by twice that
+    """A Gaussian kernel does not sum to one over the lattice (docs/chapters/ch02_filters.md):
+    splatting a constant volume along an axis gives an image that ripples with the lattice, by
+    2 exp(-2 pi^2 sigma^2) per axis (1.4% at sigma 0.5, 0.16% at 0.6), so by twice that
     over the two axes of the image. Measured (ptp / 2 / mean): 16.6%, 2.82%, 0.322%, 0.022%
     against predicted 17.0%, 2.88%, 0.328%, 0.025%. This floor does not fall with finer
     images; only a wider kernel (more blur) lowers it."""

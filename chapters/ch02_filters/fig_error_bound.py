@@ -10,7 +10,7 @@ from chapters.common import figure_path, read_json, result_path, save_figure
 def main():
     data = read_json(result_path(__file__, "error_bound.json"))
     ratios = np.array(data["ratios"])
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.4), sharey=True)
+    fig, axes = plt.subplots(1, 2, figsize=(9, 4), sharey=True)
     for ax, dims in zip(axes, ("1d", "3d"), strict=True):
         for index, (label, s) in enumerate(data["sweep"].items()):
             colour = f"C{index}"
@@ -21,11 +21,14 @@ def main():
         for target in data["targets"]:
             ax.axhline(target, color="0.6", lw=0.6, ls=":")
         ax.set_xlabel(r"feature size $\sigma / h$ (samples)")
-        ax.set_title(f"{dims.upper()}: measured worst case (solid), Fourier bound (dashed)")
+        ax.set_title(f"{dims.upper()}", fontsize=10)
+        ax.set_xticks([0.5, 1, 2, 4], ["0.5", "1", "2", "4"])
+        ax.xaxis.set_minor_formatter(plt.NullFormatter())
         ax.set_ylim(1e-5, 1.2)
         ax.grid(True, which="major", lw=0.3)
     axes[0].set_ylabel(r"$E(\sigma/h) = \max |R - f| / f(0)$")
     axes[0].legend(fontsize=8)
+    fig.suptitle("Measured worst case (solid) and Fourier bound (dashed)", fontsize=10)
     fig.tight_layout()
     save_figure(fig, figure_path(__file__, "error_bound.png"))
 

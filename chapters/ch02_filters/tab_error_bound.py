@@ -1,6 +1,6 @@
-"""Tables: the worst-case error at the derived predictions' feature sizes (measured 1-D and 3-D, the Fourier
-bound, the derived prediction), and the feature size each filter needs for 10%, 5% and
-1% error."""
+"""Tables: the worst-case error at the derived predictions' feature sizes (measured 1-D and
+3-D, the Fourier bound, the derived prediction), and the feature size each filter needs for
+10%, 5% and 1% error."""
 
 import math
 

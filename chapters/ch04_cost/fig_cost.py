@@ -35,7 +35,7 @@ def model_fit():
 def regimes():
     data = read_json(result_path(__file__, "regimes.json"))
     scenes, ms, methods = data["scenes"], data["pixels_per_voxel"], data["methods"]
-    fig, axes = plt.subplots(1, 2, figsize=(11, 3.6))
+    fig, axes = plt.subplots(1, 2, figsize=(9, 3.4))
     for ax, key, title in [(axes[0], "ns_per_point", "ns per reconstructed point"),
                            (axes[1], "seconds", "frame time (ms)")]:
         cheapest = np.zeros((len(scenes), len(ms)), int)

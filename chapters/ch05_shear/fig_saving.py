@@ -10,7 +10,7 @@ from chapters.common import figure_path, read_json, result_path, save_figure
 def main():
     data = read_json(result_path(__file__, "saving.json"))
     out, per_n3 = ratios(data)
-    fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.2))
+    fig, (left, right) = plt.subplots(1, 2, figsize=(9, 3.8))
     names = list(out)
     left.boxplot([out[n] for n in names], tick_labels=names, widths=0.5)
     for x, (lo, hi) in enumerate((PREDICTED[n] for n in names), start=1):

@@ -22,7 +22,7 @@ def series(rows, name, torus, key):
 def main():
     data = read_json(result_path(__file__, "network.json"))
     rows = data["rows"]
-    fig, axes = plt.subplots(2, 2, figsize=(12, 9))
+    fig, axes = plt.subplots(2, 2, figsize=(10, 8))
     panels = [(axes[0, 0], False, "max", "busiest channel, mesh"),
               (axes[0, 1], False, "mean", "mean channel, mesh"),
               (axes[1, 0], True, "max", "busiest channel, torus")]

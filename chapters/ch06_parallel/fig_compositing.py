@@ -26,7 +26,7 @@ def default(sel):
 def main():
     data = read_json(result_path(__file__, "compositing.json"))
     rows, nodes = data["rows"], data["nodes"]
-    fig, axes = plt.subplots(1, 3, figsize=(13, 4.2))
+    fig, axes = plt.subplots(1, 3, figsize=(11, 3.9))
     for ax, kind in zip(axes[:2], ("torus", "mesh"), strict=True):
         best = {b["nodes"]: b for b in data["best"][kind]}
         for label, pick, style in (

@@ -15,8 +15,9 @@ COLOURS = {"direct-send": "C3", "binary-swap": "C0", "radix-k": "C1", "image": "
 def main():
     data = read_json(result_path(__file__, "mpi.json"))
     ortho = data["settings"]["orbit"]
-    fig, axes = plt.subplots(2, 3, figsize=(13, 8))
-    ax = axes[0, 0]
+    fig, axes = plt.subplots(3, 2, figsize=(10, 11.5))
+    panels = axes.ravel()
+    ax = panels[0]
     for key in (*OBJECT, "image", "image-interleaved"):
         sim, meas = [], []
         for e in data["equality"][1:]:
@@ -33,7 +34,7 @@ def main():
     ax.set_ylabel("sent by the MPI renderer, kB per rank")
     ax.set_title("Bytes per rank, 2-12 ranks", fontsize=10)
     ax.legend(fontsize=7)
-    ax = axes[0, 1]
+    ax = panels[1]
     groups = [(b["scene"], b["ranks"]) for b in data["balance"]]
     keys = ("even", "interleaved", "work", "image", "image-interleaved")
     width = 0.8 / len(keys)
@@ -47,7 +48,7 @@ def main():
     ax.set_ylabel("max / mean ray samples per rank")
     ax.set_title("Load imbalance (1 is perfect)", fontsize=10)
     ax.legend(fontsize=7)
-    ax = axes[0, 2]
+    ax = panels[2]
     memory = data["memory"]
     ranks = np.arange(memory["ranks"])
     ax.bar(ranks, np.array(memory["peak"]) / 2**20, color="C1", label="peak during the frame")
@@ -59,7 +60,7 @@ def main():
     ax.set_ylabel("MiB")
     ax.set_title(f"Memory per rank, {memory['ranks']} ranks reading a .npy file", fontsize=10)
     ax.legend(fontsize=7)
-    ax = axes[1, 0]
+    ax = panels[3]
     times = data["summary"]["times"]
     for name in OBJECT:
         measured = [(t["ranks"], times[f"{name} {t['ranks']}"]) for t in data["timing"]]
@@ -79,8 +80,8 @@ def main():
     ax.set_ylabel("seconds per frame")
     ax.set_title("Frame time: medians (bars: least to most) and model", fontsize=10)
     ax.legend(fontsize=7)
-    for ax, key, label in ((axes[1, 1], "seconds", "median ms per frame"),
-                           (axes[1, 2], "bytes", "most MB sent by a rank")):
+    for ax, key, label in ((panels[4], "seconds", "median ms per frame"),
+                           (panels[5], "bytes", "most MB sent by a rank")):
         for run, style in zip(data["compositing"], ("-o", "--s", ":^"), strict=False):
             for name in OBJECT:
                 sel = [c for c in run["cases"] if c["compositing"] == name]
@@ -93,7 +94,7 @@ def main():
         ax.set_ylabel(label)
         ax.set_xticks([256, 512, 1024, 2048], ["256", "512", "1024", "2048"])
         ax.set_title("Compositing alone against image size", fontsize=10)
-    axes[1, 1].legend(fontsize=6, ncol=2)
+    panels[4].legend(fontsize=6, ncol=2)
     for ax in axes.ravel():
         ax.grid(True, which="both", alpha=0.3)
         ax.xaxis.set_minor_formatter(NullFormatter())

@@ -10,7 +10,7 @@ from chapters.common import figure_path, read_json, result_path, save_figure
 def precision_figure():
     data = read_json(result_path(__file__, "precision.json"))
     opacity = read_json(result_path(__file__, "opacity.json"))
-    fig, axes = plt.subplots(1, 3, figsize=(16, 4.4))
+    fig, axes = plt.subplots(1, 3, figsize=(12, 4.2))
     ax = axes[0]
     rows = data["accumulation"]
     for mean, ls in zip(sorted({r["mean_alpha"] for r in rows}), ("-", "--", ":"), strict=True):
@@ -54,7 +54,7 @@ def precision_figure():
 
 def convergence_figure():
     data = read_json(result_path(__file__, "convergence.json"))
-    fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.2))
+    fig, (left, right) = plt.subplots(1, 2, figsize=(9, 3.8))
     for filt, entry in data["steps"].items():
         rows = entry["rows"]
         left.loglog([r["step"] for r in rows], [r["max_error"] for r in rows], "-o", ms=4,

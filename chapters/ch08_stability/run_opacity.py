@@ -85,10 +85,21 @@ def glow_sweep():
     return rows
 
 
+def growth_scale(glow, factor=2.0):
+    """The smallest glow scale at which some method's error exceeds `factor` times its error
+    at the smallest scale (where the error is the reconstruction error alone)."""
+    smallest = min(row["scale"] for row in glow)
+    floor = {row["method"]: row["relative_error"] for row in glow if row["scale"] == smallest}
+    grown = [row["scale"] for row in glow
+             if row["relative_error"] > factor * floor[row["method"]]]
+    return min(grown) if grown else None
+
+
 def main():
+    glow = glow_sweep()
     write_json(result_path(__file__, "opacity.json"), {
         "segment_models": segment_models(), "corrections": corrections(),
-        "glow": glow_sweep()})
+        "glow": glow, "glow_growth_scale": growth_scale(glow)})
 
 
 if __name__ == "__main__":
