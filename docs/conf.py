@@ -36,6 +36,8 @@ html_theme = "furo"
 html_title = "vrlib report"
 # A figure given a width (every figure in the chapters) links to its full-size file.
 html_scaled_image_link = True
+html_static_path = ["_static"]
+html_css_files = ["report.css"]
 
 
 def _load_results():

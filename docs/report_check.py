@@ -59,7 +59,6 @@ window.addEventListener("load", async () => {
   out.mathErrors = document.querySelectorAll("mjx-merror, .MathJax_Error").length;
   const column = document.querySelector("article") || document.querySelector("[role=main]") ||
                  document.body;
-  const right = column.getBoundingClientRect().right;
   for (const img of column.querySelectorAll("img")) {
     const shown = img.getBoundingClientRect().width;
     if (img.naturalWidth > 0 && shown < img.naturalWidth / 2 && !img.closest("a[href]")) {
@@ -68,8 +67,12 @@ window.addEventListener("load", async () => {
     }
   }
   for (const table of column.querySelectorAll("table")) {
+    // furo wraps each table in a padded scrolling container: a table wider than the column,
+    // or one its container has to scroll, does not fit.
     const box = table.getBoundingClientRect();
-    if (box.right > right + 1 || table.scrollWidth > column.clientWidth + 1) {
+    const scroller = table.closest(".table-wrapper");
+    if (box.width > column.clientWidth + 1 ||
+        (scroller && scroller.scrollWidth > scroller.clientWidth + 1)) {
       const caption = table.querySelector("caption");
       out.tables.push(`${caption ? caption.textContent.trim().slice(0, 60) : "a table"} ` +
                       `(${Math.round(box.width)} px in a ${column.clientWidth} px column)`);
