@@ -210,3 +210,16 @@ def test_messages_are_one_clear_line():
             text = str(error)
             assert text and "\n" not in text and len(text) < 400, name
             assert "numba" not in text.lower(), name
+
+
+def test_an_output_that_cannot_be_written_is_named_not_its_temporary(tmp_path):
+    """Outputs are written to a hidden temporary name and renamed; when the folder refuses
+    the file, the error names the file asked for."""
+    from vrlib.atomic import atomic_path
+
+    folder = tmp_path / "a-file"
+    folder.write_text("not a folder")
+    with pytest.raises(OSError, match="cannot write '.*a-file/out.png'") as caught:
+        with atomic_path(folder / "out.png"):
+            pass
+    assert ".out." not in str(caught.value)

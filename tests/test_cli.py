@@ -99,6 +99,7 @@ def test_render_reads_files(tmp_path):
     (["render", "frog", "--frame", "1", "-o", "x.png"], "--frame applies to .nii"),
     (["render", "gaussian-blob:8", "-o", "missing/x.png"], "no folder 'missing' for the output"),
     (["render", "gaussian-blob:8", "-o", "/etc/hostname/x.png"], "is a file"),
+    (["render", "gaussian-blob:8", "-o", "/proc/x.png"], "cannot write into folder '/proc'"),
     (["turntable", "gaussian-blob:8", "-o", "missing/x.gif"], "no folder"),
     (["compare", "gaussian-blob:8", "-o", "missing/x.png"], "no folder"),
     (["render", "marschner-lobb:3000", "-o", "x.png"], "samples per axis fit"),

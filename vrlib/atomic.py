@@ -36,8 +36,12 @@ def atomic_path(path):
     ('done', True)
     """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix, dir=path.parent)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=path.suffix,
+                                   dir=path.parent)
+    except OSError as error:  # named by the file asked for, not by a temporary name
+        raise OSError(error.errno, f"cannot write {str(path)!r}: {error.strerror}") from None
     os.close(fd)
     tmp = Path(tmp)
     try:

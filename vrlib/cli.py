@@ -7,9 +7,9 @@ Bad input ends with exit status 2 and a one-line message naming what was wrong.
 from __future__ import annotations
 
 import argparse
-import os
 import platform
 import sys
+import tempfile
 import warnings
 from functools import partial
 from pathlib import Path
@@ -64,8 +64,12 @@ def check_output(path, suffixes):
         raise UsageError(f"the output's folder {str(folder)!r} is a file")
     if path.is_dir():
         raise UsageError(f"output {str(path)!r} is a folder; give a file name")
-    if not os.access(folder, os.W_OK | os.X_OK):
-        raise UsageError(f"cannot write into folder {str(folder)!r} (permission denied)")
+    try:  # a file made and removed there: permissions, read-only and special file systems
+        with tempfile.TemporaryFile(dir=folder):
+            pass
+    except OSError as error:
+        raise UsageError(f"cannot write into folder {str(folder)!r} "
+                         f"({error.strerror or error})") from None
     return path
 
 
@@ -567,8 +571,11 @@ def main(argv=None):
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", EmptyImageWarning)
             args.run(args)
-    except (UsageError, ValueError, TypeError, FileNotFoundError, ImportError) as error:
-        message = str(error).splitlines()[0] if str(error) else type(error).__name__
+    except (UsageError, ValueError, TypeError, OSError, ImportError) as error:
+        if isinstance(error, OSError) and error.strerror:  # without the "[Errno n]"
+            message = f"{error.strerror}: {error.filename}" if error.filename else error.strerror
+        else:
+            message = str(error).splitlines()[0] if str(error) else type(error).__name__
         print(f"vrlib: error: {message}", file=sys.stderr)
         return 2
     for warning in caught:  # one line each, as the errors
