@@ -385,7 +385,7 @@ def cmd_compare(args):
     # Differences of the composited colour (mean of R, G and B), so that errors in shading and
     # colour show as well as errors in opacity; one symmetric scale for every panel.
     seen = reference.composited()
-    diffs = {m: (img.composited() - seen)[..., :3].mean(axis=-1) for m, img in images.items()}
+    diffs = {m: (img.composited() - seen).mean(axis=-1) for m, img in images.items()}
     bound = max([float(np.abs(d).max()) for d in diffs.values()] + [1e-12])
     columns = len(images) + 1
     fig, axes = plt.subplots(2, columns, figsize=(2.4 * columns + 1.0, 5.2),

@@ -80,8 +80,8 @@ def colour_gallery():
             colour = img.composited()
             images[f"{name}/{method}"] = colour
             errors[name][method] = {
-                "rmse": float(np.sqrt(np.mean((colour - target) ** 2))),
-                "max": float(np.abs(colour - target).max()),
+                "rmse": vrlib.metrics.rmse(colour, target),
+                "max": vrlib.metrics.max_abs_error(colour, target),
                 "seconds": img.stats.seconds}
     with atomic_path(result_path(__file__, "colour.npz")) as tmp:
         np.savez_compressed(tmp, **images)
