@@ -97,9 +97,13 @@ def reconstruct_naive(volume, filt, points_index, *, gradient=False):
     return (out, grad) if gradient else out
 
 
-def raycast_naive(volume, view, filt, transfer, step):
+def raycast_naive(volume, view, filt, transfer, step, segment_ends="lattice"):
     """Ray casting by the book: samples at t = (k + 1/2) ds inside the volume box, opacity
-    1 - exp(-density ds) (eq 1.4), colour E alpha (eq 1.9), composited front to back."""
+    1 - exp(-density ds) (eq 1.4), colour E alpha (eq 1.9), composited front to back.
+
+    With ``segment_ends="exact"`` the ray's stretch inside the box is cut into the lattice's
+    segments ``[k ds, (k + 1) ds)``, each sampled at its own middle with opacity
+    ``1 - exp(-density length)``: the ends are the only cut segments."""
     ds = step * float(volume.spacing.min())
     volume = coefficient_volume_naive(volume, filt)
     origins, directions = view.rays()
@@ -117,13 +121,19 @@ def raycast_naive(volume, view, filt, transfer, step):
             t_out = np.min(np.maximum(ta, tb)[inside])
             if not t_out > t_in:
                 continue
-            k = np.arange(math.ceil(t_in / ds - 0.5), math.ceil(t_out / ds - 0.5) + 1)
-            t = (k + 0.5) * ds
-            t = t[(t >= t_in) & (t < t_out)]
+            if segment_ends == "exact":
+                k = np.arange(math.floor(t_in / ds), math.ceil(t_out / ds))
+                a, b = np.maximum(k * ds, t_in), np.minimum((k + 1) * ds, t_out)
+                t, length = 0.5 * (a + b), b - a
+            else:
+                k = np.arange(math.ceil(t_in / ds - 0.5), math.ceil(t_out / ds - 0.5) + 1)
+                t = (k + 0.5) * ds
+                t = t[(t >= t_in) & (t < t_out)]
+                length = ds
             points = o + t[:, None] * d
             values, grad = reconstruct_naive(volume, filt, volume.world_to_index(points),
                                              gradient=True)
-            alpha = -np.expm1(-transfer.opacity_density(values) * ds)
+            alpha = -np.expm1(-transfer.opacity_density(values) * length)
             emit = transfer.emission(values)
             if transfer.shading is not None:
                 world_grad = grad / volume.spacing

@@ -24,7 +24,7 @@ from vrlib.classified import ClassifiedVolume, classify
 from vrlib.colormapping import auto_transfer, colormap, label_transfer
 from vrlib.filters import FILTERS, make_filter
 from vrlib.image import Image, RenderStats
-from vrlib.reconstruction import reconstruct
+from vrlib.reconstruction import ReconstructedField, reconstruct
 from vrlib.reference import render_reference
 from vrlib.render import METHODS, reference_image, render
 from vrlib.transfer import Glow, GradientOpacity, LookupTransfer, Phong, TransferFunction
@@ -38,6 +38,7 @@ __all__ = [
     "render_reference",
     "turntable",
     "reconstruct",
+    "ReconstructedField",
     "reference_image",
     "METHODS",
     "classify",

@@ -15,6 +15,7 @@ import time
 import numba
 import numpy as np
 
+from vrlib import validate
 from vrlib._kernels import raycast as _kernel
 from vrlib._kernels.filters import TENT
 from vrlib._scheduling import balanced_order
@@ -22,6 +23,7 @@ from vrlib.image import Image, RenderStats
 from vrlib.prefilter import Tally, prepared
 from vrlib.skipping import BLOCK, coarsen, empty_blocks, footprint_mask, visible_box
 from vrlib.value_bounds import reconstructed_range
+from vrlib.volume import lattice_extent
 
 __all__ = ["render_raycast", "cast_rays", "operations_per_sample"]
 
@@ -51,9 +53,20 @@ def operations_per_sample(filt, *, shading=False):
     return ops
 
 
+#: How the segments that the volume's faces cut are counted (``segment_ends``).
+SEGMENT_ENDS = ("lattice", "exact")
+
+
 def render_raycast(volume, view, *, filt, transfer, step, early_termination,
-                   empty_space_skipping):
-    """Ray-cast ``volume`` (arguments already validated by :func:`vrlib.render`)."""
+                   empty_space_skipping, segment_ends="lattice"):
+    """Ray-cast ``volume`` (arguments already validated by :func:`vrlib.render`).
+
+    ``segment_ends="lattice"`` lets every sample stand for a whole step, also where the
+    volume's faces cut its segment (an error of first order in the step wherever the field is
+    not zero at the faces); ``"exact"`` counts only the part of those segments inside the
+    volume, sampled at its middle (second order; :mod:`vrlib._kernels.raycast`).
+    """
+    validate.choice("segment_ends", segment_ends, SEGMENT_ENDS)
     start = time.perf_counter()
     tally = Tally()
     volume = prepared(volume, filt, tally)  # prefiltered filters: the 3-D coefficients
@@ -69,7 +82,7 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
         volume.data, offset=(0, 0, 0), global_shape=volume.shape, origin=volume.origin,
         spacing=volume.spacing, box=(box_lo, box_hi), view=view, filt=filt, transfer=transfer,
         ds=step * float(volume.spacing.min()), value_range=reconstructed_range(volume, filt),
-        early_termination=early_termination, skip=skip,
+        early_termination=early_termination, skip=skip, exact_ends=segment_ends == "exact",
     )
     stats = RenderStats(
         samples=taken,
@@ -81,7 +94,7 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
 
 
 def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, transfer, ds,
-              value_range, early_termination, skip=None):
+              value_range, early_termination, skip=None, exact_ends=False):
     """Ray-cast samples ``data`` (all of a volume, or a brick of it with ghost samples): the
     ray caster's core, which the MPI renderers run on each brick or tile.
 
@@ -99,6 +112,9 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
     skip : (empty, coarse, block, mask) or None
         Empty-space skipping grids (global blocks) and the pixels whose rays can meet a
         non-empty block, or None to sample everywhere.
+    exact_ends : bool
+        Cut the segments at the whole volume's faces to their part inside it (never at a
+        brick's own faces, so that bricks take exactly the serial samples).
 
     Returns
     -------
@@ -133,7 +149,8 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
     _kernel.raycast(
         data, np.asarray(offset, np.int64), np.asarray(global_shape, np.int64),
         np.asarray(origin, np.float64), np.asarray(spacing, np.float64),
-        np.asarray(box[0], np.float64), np.asarray(box[1], np.float64), view.packed(),
+        np.asarray(box[0], np.float64), np.asarray(box[1], np.float64),
+        *lattice_extent(global_shape, spacing, origin).T.copy(), bool(exact_ends), view.packed(),
         view.height, view.width,
         ds, *filt.code, filt.radius, filt.taps, *tables, *lighting, *by_gradient,
         early_termination, *skip,

@@ -6,6 +6,15 @@ from the ray's origin (the view's origin plane, or the eye), and stands for the 
 the whole volume: a brick renders those of its samples with ``t`` in ``[t_in, t_out)`` of its
 own box, and no sample is taken twice or missed at a boundary.
 
+With exact segment ends (``exact``), the two segments that the volume's outer faces cut
+count only their part inside the volume's box: a ray that enters at ``T_in`` and leaves at
+``T_out`` takes, for the cut segment ``k``, one sample at the middle of
+``[max(k ds, T_in), min((k + 1) ds, T_out))`` and gives it that length's opacity
+``1 - (1 - alpha)^(length / ds)`` (eq 1.4). Every other sample stays on the lattice, and only
+the volume's faces cut, never a brick's, so bricks still take exactly the serial samples. This
+removes the error of first order in the step that the faces give a field that is not zero
+there (docs/kernel.md).
+
 Classification reads a per-render table of segment opacity and colour
 (:meth:`vrlib.transfer.TransferFunction.segment_table`), linearly interpolated.
 """
@@ -63,8 +72,24 @@ def _exit(ax, ay, az, bx, by, bz, cells, counts, ux, uy, uz):
     return t_exit
 
 
+@jit(inline="always")
+def _cut_segment(k, ds, t_first, t_last):
+    """Sample position and length (as a fraction of ``ds``) of segment ``k`` cut to the
+    volume's ``[t_first, t_last)``."""
+    a = max(k * ds, t_first)
+    b = min((k + 1) * ds, t_last)
+    return 0.5 * (a + b), (b - a) / ds
+
+
+@jit(inline="always")
+def _part_of_segment(alpha, fraction):
+    """Opacity of ``fraction`` of a segment whose whole opacity is ``alpha`` (eq 1.4)."""
+    return -math.expm1(fraction * math.log1p(-alpha)) if alpha < 1.0 else 1.0
+
+
 @parallel_jit
-def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, camera, height, width, ds,
+def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_hi, exact,
+            camera, height, width, ds,
             fkind, fp0, fp1, fp2, radius, ntaps,
             tstart, tinv, alpha_tab, color_tab, emit_tab,
             shade, ka, kd, ks, shininess, light, headlight, ramp_x, ramp_y, by_gradient,
@@ -74,7 +99,8 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, camera, heigh
     ``data`` holds the samples from global index ``offset`` on (the whole volume, or a brick
     with ghost samples) of a volume of global shape ``gshape`` whose sample 0 is at world
     ``origin``; the rays of the packed view ``camera`` (one per pixel of a ``height x width``
-    image) sample the world box ``[box_lo, box_hi]``. The image is cut into
+    image) sample the world box ``[box_lo, box_hi]`` of a volume whose own box is
+    ``[vol_lo, vol_hi]`` (cut exactly at its faces when ``exact``). The image is cut into
     ``tile_h x tile_w`` pixel tiles, taken in the order ``order`` (spread over the image so that
     threads share the work evenly); neighbouring rays read neighbouring voxels, so a tile keeps
     them in cache. Each pixel is computed independently and in a fixed order: the image does
@@ -98,7 +124,7 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, camera, heigh
         tile_id = order[it]
         samples[tile_id] = _tile(
             tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, origin,
-            box_lo, box_hi, camera, height, width,
+            box_lo, box_hi, vol_lo, vol_hi, exact, camera, height, width,
             ds, fkind, fp0, fp1, fp2, radius, ntaps, tstart, tinv, alpha_tab, color_tab,
             emit_tab, shade, ka, kd, ks, shininess, light, headlight, ramp_x, ramp_y,
             by_gradient, threshold, empty, coarse, block, mask, tile_h, tile_w, out, grey)
@@ -106,8 +132,8 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, camera, heigh
 
 @jit
 def _tile(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, origin,
-          box_lo, box_hi, camera, height, width, ds, fkind, fp0, fp1, fp2, radius, ntaps, tstart,
-          tinv, alpha_tab, color_tab, emit_tab, shade, ka, kd, ks, shininess, light, headlight,
+          box_lo, box_hi, vol_lo, vol_hi, exact, camera, height, width, ds, fkind, fp0, fp1, fp2,
+          radius, ntaps, tstart, tinv, alpha_tab, color_tab, emit_tab, shade, ka, kd, ks, shininess, light, headlight,
           ramp_x, ramp_y, by_gradient, threshold, empty, coarse, block, mask, tile_h, tile_w, out,
           grey):
     """Tile ``tile_id`` of :func:`raycast` (the same arguments): its pixels' rays, front to
@@ -152,11 +178,28 @@ def _tile(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, 
         by = d[1] * inv[1]
         bz = d[2] * inv[2]
         k = math.ceil(t_in / ds - 0.5)
+        # Exact ends: the segments k_first and k_last that the volume's faces cut; -1 (no
+        # segment) without. A cut segment's sample may lie before sample k.
+        k_first = k_last = -1
+        t_first = t_last = 0.0
+        if exact:
+            t_first, t_last = ray_box(o, d, vol_lo, vol_hi)
+            t_first = max(t_first, 0.0)
+            k_first = math.floor(t_first / ds)
+            k_last = math.ceil(t_last / ds) - 1
+            if k - 1 == k_first or k - 1 == k_last:
+                k -= 1
         if plain:
             # The common case, its loop stripped: tent filter, white unshaded emission,
             # nothing to skip. The same arithmetic as the general loop below.
             while True:
                 t = (k + 0.5) * ds
+                fraction = 1.0
+                if k == k_first or k == k_last:
+                    t, fraction = _cut_segment(k, ds, t_first, t_last)
+                    if t < t_in:  # another brick's sample
+                        k += 1
+                        continue
                 if t >= t_out:
                     break
                 value = trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ax + t * bx,
@@ -167,6 +210,8 @@ def _tile(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, 
                 alpha = alpha_tab[i] + w * (alpha_tab[i + 1] - alpha_tab[i])
                 if not alpha > 0.0:
                     continue
+                if fraction != 1.0:
+                    alpha = _part_of_segment(alpha, fraction)
                 remaining = 1.0 - acc_a
                 acc_r += remaining * alpha
                 acc_a += remaining * alpha
@@ -180,6 +225,12 @@ def _tile(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, 
             t_check = -math.inf if block > 0 else math.inf
             while True:
                 t = (k + 0.5) * ds
+                fraction = 1.0
+                if k == k_first or k == k_last:
+                    t, fraction = _cut_segment(k, ds, t_first, t_last)
+                    if t < t_in:  # another brick's sample
+                        k += 1
+                        continue
                 if t >= t_out:
                     break
                 ux = ax + t * bx
@@ -199,6 +250,8 @@ def _tile(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, 
                     k_next = max(math.ceil(t_exit / ds - 0.5), k + 1)
                     while k_next > k + 1:
                         tb = (k_next - 0.5) * ds
+                        if k_next - 1 == k_first or k_next - 1 == k_last:
+                            tb = _cut_segment(k_next - 1, ds, t_first, t_last)[0]
                         if _is_empty(empty, block, ax + tb * bx, ay + tb * by, az + tb * bz):
                             break
                         k_next -= 1
@@ -243,6 +296,12 @@ def _tile(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, 
                     cr = color_tab[i, 0] + w * (color_tab[i + 1, 0] - color_tab[i, 0])
                     cg = color_tab[i, 1] + w * (color_tab[i + 1, 1] - color_tab[i, 1])
                     cb = color_tab[i, 2] + w * (color_tab[i + 1, 2] - color_tab[i, 2])
+                if fraction != 1.0:  # a segment cut by the volume's face
+                    part = _part_of_segment(alpha, fraction)
+                    cr *= part / alpha
+                    cg *= part / alpha
+                    cb *= part / alpha
+                    alpha = part
                 # Front-to-back over, eqs 1.7-1.8.
                 remaining = 1.0 - acc_a
                 acc_r += remaining * cr
