@@ -133,9 +133,9 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
 @jit
 def _tile(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, origin,
           box_lo, box_hi, vol_lo, vol_hi, exact, camera, height, width, ds, fkind, fp0, fp1, fp2,
-          radius, ntaps, tstart, tinv, alpha_tab, color_tab, emit_tab, shade, ka, kd, ks, shininess, light, headlight,
-          ramp_x, ramp_y, by_gradient, threshold, empty, coarse, block, mask, tile_h, tile_w, out,
-          grey):
+          radius, ntaps, tstart, tinv, alpha_tab, color_tab, emit_tab, shade, ka, kd, ks,
+          shininess, light, headlight, ramp_x, ramp_y, by_gradient, threshold, empty, coarse,
+          block, mask, tile_h, tile_w, out, grey):
     """Tile ``tile_id`` of :func:`raycast` (the same arguments): its pixels' rays, front to
     back, in a fixed order; returns the samples taken. ``flat`` is ``data`` raveled, ``inv``
     the inverse spacing, ``fine_counts`` and ``coarse_counts`` the skip grids' shapes."""
