@@ -78,9 +78,29 @@ def convergence_figure():
     save_figure(fig, figure_path(__file__, "convergence.png"))
 
 
+def segment_ends_figure():
+    data = read_json(result_path(__file__, "segment_ends.json"))
+    scenes = list(dict.fromkeys(r["scene"] for r in data["rows"]))
+    fig, axes = plt.subplots(1, len(scenes), figsize=(11, 3.6), sharey=True)
+    styles = {("trilinear", "lattice"): "--o", ("trilinear", "exact"): "-o",
+              ("catmull-rom", "lattice"): "--s", ("catmull-rom", "exact"): "-s"}
+    for ax, scene in zip(axes, scenes, strict=True):
+        for r in (r for r in data["rows"] if r["scene"] == scene):
+            ax.loglog(r["steps"], r["rmse"], styles[r["filter"], r["ends"]], ms=4,
+                      label=f"{r['filter']}, {r['ends']} ends (order {r['order']:.2f})")
+        ax.set_title(scene, fontsize=10)
+        ax.set_xlabel("ray step (voxels)")
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7)
+    axes[0].set_ylabel("rmse against the reconstructed field's exact image")
+    fig.tight_layout()
+    save_figure(fig, figure_path(__file__, "segment_ends.png"))
+
+
 def main():
     precision_figure()
     convergence_figure()
+    segment_ends_figure()
 
 
 if __name__ == "__main__":
