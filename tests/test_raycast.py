@@ -2,6 +2,7 @@
 
 import math
 
+import naive
 import numba
 import numpy as np
 import pytest
@@ -53,6 +54,85 @@ def test_exact_segment_ends_match_naive_twin(projection, filt, transfer):
     np.testing.assert_allclose(fast.rgba, slow, atol=1e-6)
     lattice = raycast_naive(vol, view, vrlib.make_filter(filt), transfer, 0.37)
     assert np.abs(fast.rgba - lattice).max() > 1e-4  # the ends do change the image
+
+
+@pytest.mark.parametrize("projection", ["orthographic", "perspective"])
+@pytest.mark.parametrize("filt", ["box", "trilinear", "catmull-rom", ("gaussian", 0.5, 1.5),
+                                  "omoms"], ids=str)
+@pytest.mark.parametrize("transfer", [
+    Glow(3.0), TABLE, Glow(2.0, shading=Phong(specular=0.4)),
+    LookupTransfer([0.0, 2.0], shading=Phong(light=(1, 2, 3)),
+                   gradient_opacity=vrlib.GradientOpacity([0.0, 3.0], [0.2, 1.0]))],
+    ids=["glow", "table", "glow-shaded", "table-shaded-ramp"])
+def test_preintegration_matches_naive_twin(projection, filt, transfer):
+    """Pre-integrated classification equals the twin that integrates the transfer function
+    by brute force between each segment's end values (400 pieces a segment): opacity to
+    1e-5, colour to 1e-3 (the mean-emission table's bilinear reading between its 256
+    entries). The default Gaussian is left out: truncated at 2 voxels, where it is not zero,
+    it reconstructs a field that jumps on the lattice planes, and the segments' ends at the
+    volume's faces lie on them, where the twin's and the kernel's rounding of a position may
+    fall on either side (a difference of 3e-4 measured)."""
+    vol = data_gen.make_field("marschner-lobb").sample((9, 11, 10))
+    view = View.orbit(azimuth=33, elevation=-21, size=(7, 9), projection=projection)
+    fast = render(vol, view, filter=filt, transfer=transfer, step=0.71, early_termination=1.0,
+                  classification="preintegrated")
+    slow = naive.raycast_preintegrated_naive(vol, view, vrlib.make_filter(filt), transfer,
+                                             0.71)
+    np.testing.assert_allclose(fast.alpha, slow[..., 3], atol=1e-5)
+    np.testing.assert_allclose(fast.rgba, slow, atol=1e-3)
+    assert fast.alpha.max() > 0.1
+
+
+@pytest.mark.parametrize("filt", ["trilinear", "catmull-rom"])
+@pytest.mark.parametrize("transfer", [Glow(5.0), TABLE], ids=["glow", "table"])
+def test_preintegrated_skipping_changes_nothing(filt, transfer):
+    """Empty-space skipping of pre-integrated segments (skipped by their front end, a run
+    only while its last segment ends in the same empty block) leaves the image bit for bit,
+    on sparse blobs from several views, perspective with the eye inside included."""
+    field = data_gen.make_field("random-blobs", count=3, seed=5, sigma=(0.04, 0.06))
+    data = field.sample(48).data.copy()
+    data[data < 1e-3] = 0.0
+    vol = Volume(data)
+    views = [View.orbit(azimuth=a, elevation=e, size=40) for a, e in [(0, 0), (37, 23)]]
+    views.append(View.orbit(azimuth=10, elevation=5, size=40, projection="perspective",
+                            distance=0.5, fov=70))
+    for view in views:
+        for step in (0.5, 3.0):
+            options = dict(filter=filt, transfer=transfer, step=step,
+                           classification="preintegrated")
+            skipped = render(vol, view, **options)
+            full = render(vol, view, empty_space_skipping=False, **options)
+            assert np.array_equal(skipped.rgba, full.rgba)
+            assert skipped.stats.samples < 0.8 * full.stats.samples  # 0.68 measured
+
+
+def test_preintegration_is_exact_on_a_linear_field():
+    """Along every ray a linear field is linear: pre-integration's opacity is then exact at
+    any step, where point sampling misses a narrow opacity peak. Measured (17^3, 48^2, a
+    peak 0.03 of the value range wide): pre-integrated rmse 9e-7 at steps 2 to 1/4, point
+    sampling 0.43 at step 2 and 0.012 at 1/4."""
+    z, y, x = np.meshgrid(*[np.linspace(-1.0, 1.0, 17)] * 3, indexing="ij")
+    vol = Volume(0.25 * (x + 1.0) + 0.25 * (y + 1.0))
+    view = View.orbit(azimuth=30, elevation=20, size=48)
+    grid = np.linspace(0.0, 1.0, 1001)
+    peak = LookupTransfer(40.0 * np.clip(1.0 - np.abs(grid - 0.5) / 0.015, 0.0, None),
+                          value_range=vol.value_range)
+    exact = render_reference(vrlib.ReconstructedField(vol), view, transfer=peak, tol=1e-8)
+    for step in (2.0, 0.5):
+        pre = render(vol, view, transfer=peak, step=step, early_termination=1.0,
+                     classification="preintegrated")
+        point = render(vol, view, transfer=peak, step=step, early_termination=1.0,
+                       segment_ends="exact")
+        assert metrics.rmse(pre, exact) < 1e-5
+        assert metrics.rmse(point, exact) > 1e-2
+
+
+def test_preintegration_refuses_what_it_cannot_do():
+    vol = small_volume()
+    with pytest.raises(ValueError, match="segment_ends='exact'"):
+        render(vol, View.orbit(size=4), classification="preintegrated", segment_ends="lattice")
+    with pytest.raises(ValueError, match="classification"):
+        render(vol, View.orbit(size=4), classification="pre-integrated")
 
 
 def test_exact_segment_ends_converge_at_second_order():

@@ -55,34 +55,62 @@ def operations_per_sample(filt, *, shading=False):
 
 #: How the segments that the volume's faces cut are counted (``segment_ends``).
 SEGMENT_ENDS = ("lattice", "exact")
+#: How a segment is classified (``classification``).
+CLASSIFICATIONS = ("point", "preintegrated")
 
 
 def render_raycast(volume, view, *, filt, transfer, step, early_termination,
-                   empty_space_skipping, segment_ends="lattice"):
+                   empty_space_skipping, segment_ends=None, classification="point"):
     """Ray-cast ``volume`` (arguments already validated by :func:`vrlib.render`).
 
     ``segment_ends="lattice"`` lets every sample stand for a whole step, also where the
     volume's faces cut its segment (an error of first order in the step wherever the field is
     not zero at the faces); ``"exact"`` counts only the part of those segments inside the
-    volume, sampled at its middle (second order; :mod:`vrlib._kernels.raycast`).
+    volume, sampled at its middle (second order; :mod:`vrlib._kernels.raycast`). The default
+    is ``"lattice"`` with point classification and ``"exact"`` (the only choice) with
+    pre-integration.
+
+    ``classification="point"`` classifies each segment by the value at its middle;
+    ``"preintegrated"`` by the values at its two ends, through a table that integrates the
+    transfer function between them (:meth:`vrlib.TransferFunction.preintegrated_table`):
+    steep transfer functions are then not aliased. It takes the field as linear along a
+    segment (a step at its middle with the box filter); gradient opacity and shading use the
+    gradient at the segment's middle (docs/kernel.md).
     """
+    validate.choice("classification", classification, CLASSIFICATIONS)
+    preint = classification == "preintegrated"
+    if segment_ends is None:
+        segment_ends = "exact" if preint else "lattice"
     validate.choice("segment_ends", segment_ends, SEGMENT_ENDS)
+    if preint and segment_ends != "exact":
+        raise ValueError("classification='preintegrated' takes its segments' values at their "
+                         "ends, which must lie inside the volume: use segment_ends='exact' "
+                         "(or leave it out)")
+    if preint and volume.holes is not None:
+        raise ValueError("classification='preintegrated' cannot take holes "
+                         "(nan='transparent'): no value runs linearly into a hole; use "
+                         "classification='point'")
     start = time.perf_counter()
     tally = Tally()
     volume = prepared(volume, filt, tally)  # prefiltered filters: the 3-D coefficients
     extent = volume.extent
     box_lo, box_hi = extent[:, 0].copy(), extent[:, 1].copy()
+    ds = step * float(volume.spacing.min())
     skip = None
     if empty_space_skipping:
         empty = empty_blocks(volume, filt, transfer, block=BLOCK)
         if empty.any():  # with nothing to skip, checking would only cost time
             box_lo, box_hi = visible_box(volume, empty, BLOCK, box_lo, box_hi)
+            if preint:  # a segment owned outside the box reaches half a step into it
+                box_lo = np.maximum(box_lo - 0.5 * ds, extent[:, 0])
+                box_hi = np.minimum(box_hi + 0.5 * ds, extent[:, 1])
             skip = (empty, coarsen(empty), BLOCK, footprint_mask(view, volume, empty, BLOCK))
     rgba, taken = cast_rays(
         volume.data, offset=(0, 0, 0), global_shape=volume.shape, origin=volume.origin,
         spacing=volume.spacing, box=(box_lo, box_hi), view=view, filt=filt, transfer=transfer,
-        ds=step * float(volume.spacing.min()), value_range=reconstructed_range(volume, filt),
+        ds=ds, value_range=reconstructed_range(volume, filt),
         early_termination=early_termination, skip=skip, exact_ends=segment_ends == "exact",
+        preintegrated=preint,
     )
     stats = RenderStats(
         samples=taken,
@@ -94,7 +122,8 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
 
 
 def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, transfer, ds,
-              value_range, early_termination, skip=None, exact_ends=False):
+              value_range, early_termination, skip=None, exact_ends=False,
+              preintegrated=False):
     """Ray-cast samples ``data`` (all of a volume, or a brick of it with ghost samples): the
     ray caster's core, which the MPI renderers run on each brick or tile.
 
@@ -115,6 +144,10 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
     exact_ends : bool
         Cut the segments at the whole volume's faces to their part inside it (never at a
         brick's own faces, so that bricks take exactly the serial samples).
+    preintegrated : bool
+        Classify each segment from its values at its two ends (needs ``exact_ends``; the
+        box filter takes the value as a step at the segment's middle). A brick then needs
+        ghost samples half a step beyond its box as well.
 
     Returns
     -------
@@ -137,6 +170,12 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
     by_gradient = (np.zeros(2), np.zeros(2), False) if ramp is None else (
         ramp.magnitudes, ramp.factors, True)
     grey = shading is None and bool(np.all(tables[4] == 1.0))  # colour equals opacity
+    if preintegrated:
+        profile = "step" if filt.radius <= 0.5 else "linear"  # the box filter jumps
+        pre = transfer.preintegrated_table(ds, *value_range, profile=profile)
+    else:
+        pre = (0.0, 1.0, np.zeros(2), np.zeros(2), np.ones((2, 3)), False, True, 0.0, 1.0,
+               np.ones((2, 2, 3)))
     out = np.empty(view.shape + (4,))
     rows, cols = -(-view.height // TILE[0]), -(-view.width // TILE[1])
     samples = np.zeros(rows * cols, dtype=np.int64)
@@ -155,6 +194,7 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
         ds, *filt.code, filt.radius, filt.taps, *tables, *lighting, *by_gradient,
         early_termination, *skip,
         *TILE, balanced_order(costs, numba.get_num_threads()), out, samples, grey,
+        bool(preintegrated), *pre,
     )
     np.clip(out[..., 3], 0.0, 1.0, out=out[..., 3])
     return out, int(samples.sum())

@@ -29,6 +29,7 @@ from numba import prange
 from vrlib._kernels._jit import jit, parallel_jit
 from vrlib._kernels.camera import pixel_ray, ray_box
 from vrlib._kernels.filters import CUBIC, TENT
+from vrlib._kernels.preintegration import bilinear_channel, mean_density
 from vrlib._kernels.sampling import (
     gradient,
     reconstruct,
@@ -37,8 +38,8 @@ from vrlib._kernels.sampling import (
     tricubic,
     trilinear,
 )
-from vrlib._kernels.shading import classify_by_gradient
-from vrlib._kernels.tables import lookup
+from vrlib._kernels.shading import classify_by_gradient, modulate_by_gradient
+from vrlib._kernels.tables import interpolate, interpolate_channel, lookup
 
 
 @jit
@@ -87,13 +88,33 @@ def _part_of_segment(alpha, fraction):
     return -math.expm1(fraction * math.log1p(-alpha)) if alpha < 1.0 else 1.0
 
 
+@jit(inline="always")
+def _value(data, flat, nx, nxy, offset, gshape, ux, uy, uz, fkind, fp0, fp1, fp2, radius,
+           ntaps, wx, wy, wz):
+    """The reconstructed value at global index position ``(ux, uy, uz)``: the two common
+    filters unrolled, the others through the general loop."""
+    if fkind == TENT:
+        return trilinear(flat, nx, nxy, offset[0], offset[1], offset[2], gshape[0], gshape[1],
+                         gshape[2], ux, uy, uz)
+    if fkind == CUBIC:
+        return tricubic(flat, nx, nxy, offset[0], offset[1], offset[2], gshape[0], gshape[1],
+                        gshape[2], ux, uy, uz, fp0, fp1, fp2)
+    if ntaps == 4:
+        return separable4(flat, nx, nxy, offset[0], offset[1], offset[2], gshape[0],
+                          gshape[1], gshape[2], ux, uy, uz, fkind, fp0, fp1, fp2, radius)
+    return reconstruct(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1, fp2, radius, ntaps,
+                       wx, wy, wz)
+
+
 @parallel_jit
 def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_hi, exact,
             camera, height, width, ds,
             fkind, fp0, fp1, fp2, radius, ntaps,
             tstart, tinv, alpha_tab, color_tab, emit_tab,
             shade, ka, kd, ks, shininess, light, headlight, ramp_x, ramp_y, by_gradient,
-            threshold, empty, coarse, block, mask, tile_h, tile_w, order, out, samples, grey):
+            threshold, empty, coarse, block, mask, tile_h, tile_w, order, out, samples, grey,
+            preint, pre_start, pre_inv, pre_density, pre_psi, pre_emission, pre_step, pre_grey,
+            col_start, col_inv, pre_mean):
     """Render ``out[row, col] = (r, g, b, a)`` premultiplied; count samples per tile.
 
     ``data`` holds the samples from global index ``offset`` on (the whole volume, or a brick
@@ -111,6 +132,13 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
     (``block = 0`` turns skipping off), and ``mask`` the pixels whose rays can meet a
     non-empty block; ``threshold = 1`` turns early ray termination off.
     ``grey`` says the emission is 1 everywhere and unshaded, so colour equals opacity.
+    ``preint`` classifies each segment from its values at its two ends instead of its
+    middle's value: the opacity from the mean density (``pre_density`` and its running
+    integral ``pre_psi`` on the grid ``(value - pre_start) * pre_inv``), the colour as the
+    opacity times the mean emission ``pre_mean[front, back]`` (grid ``(value - col_start) *
+    col_inv``) unless ``pre_grey``; with ``pre_step`` (the box filter) half a segment at each
+    end's value, with ``pre_emission`` on the same grid as the density
+    (:class:`vrlib.transfer.PreintegratedTable`).
     ``by_gradient`` multiplies the density by the piecewise-linear factor through
     ``(ramp_x, ramp_y)`` of the gradient magnitude (per world unit).
     """
@@ -127,7 +155,9 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
             box_lo, box_hi, vol_lo, vol_hi, exact, camera, height, width,
             ds, fkind, fp0, fp1, fp2, radius, ntaps, tstart, tinv, alpha_tab, color_tab,
             emit_tab, shade, ka, kd, ks, shininess, light, headlight, ramp_x, ramp_y,
-            by_gradient, threshold, empty, coarse, block, mask, tile_h, tile_w, out, grey)
+            by_gradient, threshold, empty, coarse, block, mask, tile_h, tile_w, out, grey,
+            preint, pre_start, pre_inv, pre_density, pre_psi, pre_emission, pre_step, pre_grey,
+            col_start, col_inv, pre_mean)
 
 
 @jit
@@ -135,7 +165,8 @@ def _tile(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, 
           box_lo, box_hi, vol_lo, vol_hi, exact, camera, height, width, ds, fkind, fp0, fp1, fp2,
           radius, ntaps, tstart, tinv, alpha_tab, color_tab, emit_tab, shade, ka, kd, ks,
           shininess, light, headlight, ramp_x, ramp_y, by_gradient, threshold, empty, coarse,
-          block, mask, tile_h, tile_w, out, grey):
+          block, mask, tile_h, tile_w, out, grey, preint, pre_start, pre_inv, pre_density,
+          pre_psi, pre_emission, pre_step, pre_grey, col_start, col_inv, pre_mean):
     """Tile ``tile_id`` of :func:`raycast` (the same arguments): its pixels' rays, front to
     back, in a fixed order; returns the samples taken. ``flat`` is ``data`` raveled, ``inv``
     the inverse spacing, ``fine_counts`` and ``coarse_counts`` the skip grids' shapes."""
@@ -145,7 +176,9 @@ def _tile(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, 
     oz, oy, ox = offset[0], offset[1], offset[2]
     gz, gy, gx = gshape[0], gshape[1], gshape[2]
     ntab = alpha_tab.shape[0]
-    plain = fkind == TENT and grey and not shade and not by_gradient and block == 0
+    npre = pre_mean.shape[0]
+    plain = (fkind == TENT and grey and not shade and not by_gradient and block == 0
+             and not preint)
     row0 = (tile_id // tiles_across) * tile_h
     col0 = (tile_id % tiles_across) * tile_w
     wx, wy, wz, dx, dy, dz = tap_scratch()
@@ -189,6 +222,8 @@ def _tile(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, 
             k_last = math.ceil(t_last / ds) - 1
             if k - 1 == k_first or k - 1 == k_last:
                 k -= 1
+        k_front = -1  # the segment whose front value `front` holds (pre-integration)
+        front = 0.0
         if plain:
             # The common case, its loop stripped: tent filter, white unshaded emission,
             # nothing to skip. The same arithmetic as the general loop below.
@@ -236,66 +271,158 @@ def _tile(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, 
                 ux = ax + t * bx
                 uy = ay + t * by
                 uz = az + t * bz
-                if t >= t_check and not _is_empty(empty, block, ux, uy, uz):
-                    t_check = _exit(ax, ay, az, bx, by, bz, block, fine_counts, ux, uy, uz)
-                elif t >= t_check:
+                # A sample is skipped by its position; a pre-integrated segment, which
+                # reaches from one end to the other, by its front end.
+                t_a = k * ds
+                if fraction != 1.0:
+                    t_a = max(t_a, t_first)
+                tc = t_a if preint else t
+                cx = ax + tc * bx
+                cy = ay + tc * by
+                cz = az + tc * bz
+                if tc >= t_check and not _is_empty(empty, block, cx, cy, cz):
+                    t_check = _exit(ax, ay, az, bx, by, bz, block, fine_counts, cx, cy, cz)
+                elif tc >= t_check:
                     # Jump past the largest empty block here, then step back over any
                     # sample that rounding placed in a block that is not empty: the image
                     # is unchanged.
-                    if _is_empty(coarse, 4 * block, ux, uy, uz):
+                    if _is_empty(coarse, 4 * block, cx, cy, cz):
                         t_exit = _exit(ax, ay, az, bx, by, bz, 4 * block, coarse_counts,
-                                       ux, uy, uz)
+                                       cx, cy, cz)
                     else:
-                        t_exit = _exit(ax, ay, az, bx, by, bz, block, fine_counts, ux, uy, uz)
-                    k_next = max(math.ceil(t_exit / ds - 0.5), k + 1)
-                    while k_next > k + 1:
-                        tb = (k_next - 0.5) * ds
-                        if k_next - 1 == k_first or k_next - 1 == k_last:
-                            tb = _cut_segment(k_next - 1, ds, t_first, t_last)[0]
-                        if _is_empty(empty, block, ax + tb * bx, ay + tb * by, az + tb * bz):
-                            break
-                        k_next -= 1
-                    k = k_next
-                    continue
-                # The two common filters unrolled, the others through the general loop.
-                if fkind == TENT:
-                    value = trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz)
-                elif fkind == CUBIC:
-                    value = tricubic(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz,
-                                     fp0, fp1, fp2)
-                elif ntaps == 4:
-                    value = separable4(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz,
-                                       fkind, fp0, fp1, fp2, radius)
-                else:
-                    value = reconstruct(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1, fp2,
-                                        radius, ntaps, wx, wy, wz)
-                taken += 1
-                k += 1
-                # Classify: segment opacity 1 - exp(-density ds) (eq 1.4) and colour E alpha
-                # (eq 1.9), from the table.
-                i, w = lookup((value - tstart) * tinv, ntab)
-                alpha = alpha_tab[i] + w * (alpha_tab[i + 1] - alpha_tab[i])
-                if not alpha > 0.0:
-                    continue  # a transparent segment adds exactly nothing
-                if grey and not by_gradient:
-                    cr = cg = cb = alpha  # white emission, no shading: colour = opacity
-                elif shade or by_gradient:
-                    gx_, gy_, gz_ = gradient(data, offset, gshape, ux, uy, uz, fkind, fp0,
-                                             fp1, fp2, radius, ntaps, wx, wy, wz, dx, dy, dz)
-                    if headlight:
-                        lx, ly, lz = -d[0], -d[1], -d[2]
+                        t_exit = _exit(ax, ay, az, bx, by, bz, block, fine_counts, cx, cy, cz)
+                    if preint:
+                        # Skip the segments that end inside the block too: both ends of
+                        # the run lie in one empty box, so all of it does.
+                        k_next = math.floor(t_exit / ds)
+                        while k_next > k:
+                            tb = k_next * ds
+                            if _is_empty(empty, block, ax + tb * bx, ay + tb * by,
+                                         az + tb * bz):
+                                break
+                            k_next -= 1
+                        if k_next > k:
+                            k = k_next
+                            continue
                     else:
-                        lx, ly, lz = light[0], light[1], light[2]
-                    alpha, cr, cg, cb = classify_by_gradient(
-                        alpha, i, w, emit_tab, gx_ * inv[0], gy_ * inv[1], gz_ * inv[2],
-                        by_gradient, ramp_x, ramp_y, shade, lx, ly, lz, d[0], d[1], d[2],
-                        ka, kd, ks, shininess)
+                        k_next = max(math.ceil(t_exit / ds - 0.5), k + 1)
+                        while k_next > k + 1:
+                            tb = (k_next - 0.5) * ds
+                            if k_next - 1 == k_first or k_next - 1 == k_last:
+                                tb = _cut_segment(k_next - 1, ds, t_first, t_last)[0]
+                            if _is_empty(empty, block, ax + tb * bx, ay + tb * by,
+                                         az + tb * bz):
+                                break
+                            k_next -= 1
+                        k = k_next
+                        continue
+                if preint:
+                    # Pre-integrated: the segment's values at its two ends (the back of one
+                    # segment is the front of the next).
+                    t_b = (k + 1) * ds
+                    if fraction != 1.0:
+                        t_b = min(t_b, t_last)
+                    if k != k_front:
+                        front = _value(data, flat, nx, nxy, offset, gshape, ax + t_a * bx,
+                                       ay + t_a * by, az + t_a * bz, fkind, fp0, fp1, fp2,
+                                       radius, ntaps, wx, wy, wz)
+                        taken += 1
+                    back = _value(data, flat, nx, nxy, offset, gshape, ax + t_b * bx,
+                                  ay + t_b * by, az + t_b * bz, fkind, fp0, fp1, fp2, radius,
+                                  ntaps, wx, wy, wz)
+                    taken += 1
+                    # A cut segment's own length: its opacity is exact, its colour's mean
+                    # emission that of a whole segment.
+                    length = ds
+                    if fraction != 1.0:
+                        length = t_b - t_a
+                        fraction = 1.0
+                    if pre_step:
+                        # A step at the middle (the box filter): half a segment at the front
+                        # value over half at the back value, exactly.
+                        half_a = -math.expm1(-0.5 * length * interpolate(
+                            pre_density, pre_start, pre_inv, front))
+                        half_b = -math.expm1(-0.5 * length * interpolate(
+                            pre_density, pre_start, pre_inv, back))
+                        alpha = 1.0 - (1.0 - half_a) * (1.0 - half_b)
+                        cr = cg = cb = alpha
+                        if alpha > 0.0 and not pre_grey:
+                            cr = half_a * interpolate_channel(pre_emission, pre_start, pre_inv,
+                                                              front, 0) \
+                                + (1.0 - half_a) * half_b * interpolate_channel(
+                                    pre_emission, pre_start, pre_inv, back, 0)
+                            cg = half_a * interpolate_channel(pre_emission, pre_start, pre_inv,
+                                                              front, 1) \
+                                + (1.0 - half_a) * half_b * interpolate_channel(
+                                    pre_emission, pre_start, pre_inv, back, 1)
+                            cb = half_a * interpolate_channel(pre_emission, pre_start, pre_inv,
+                                                              front, 2) \
+                                + (1.0 - half_a) * half_b * interpolate_channel(
+                                    pre_emission, pre_start, pre_inv, back, 2)
+                    else:
+                        # A linear ramp: the opacity exact from the density's running
+                        # integral, the colour from the (front, back) table of the
+                        # segment's mean emission.
+                        alpha = -math.expm1(-length * mean_density(
+                            front, back, pre_start, pre_inv, pre_density, pre_psi))
+                        cr = cg = cb = alpha
+                        if alpha > 0.0 and not pre_grey:
+                            px = (front - col_start) * col_inv
+                            py = (back - col_start) * col_inv
+                            cr = alpha * bilinear_channel(pre_mean, px, py, npre, 0)
+                            cg = alpha * bilinear_channel(pre_mean, px, py, npre, 1)
+                            cb = alpha * bilinear_channel(pre_mean, px, py, npre, 2)
+                    front = back
+                    k += 1
+                    k_front = k
                     if not alpha > 0.0:
                         continue
+                    if shade or by_gradient:
+                        # The gradient at the segment's middle modulates the segment.
+                        gx_, gy_, gz_ = gradient(data, offset, gshape, ux, uy, uz, fkind, fp0,
+                                                 fp1, fp2, radius, ntaps, wx, wy, wz, dx, dy,
+                                                 dz)
+                        if headlight:
+                            lx, ly, lz = -d[0], -d[1], -d[2]
+                        else:
+                            lx, ly, lz = light[0], light[1], light[2]
+                        alpha, cr, cg, cb = modulate_by_gradient(
+                            alpha, cr, cg, cb, gx_ * inv[0], gy_ * inv[1], gz_ * inv[2],
+                            by_gradient, ramp_x, ramp_y, shade, lx, ly, lz, d[0], d[1], d[2],
+                            ka, kd, ks, shininess)
+                        if not alpha > 0.0:
+                            continue
                 else:
-                    cr = color_tab[i, 0] + w * (color_tab[i + 1, 0] - color_tab[i, 0])
-                    cg = color_tab[i, 1] + w * (color_tab[i + 1, 1] - color_tab[i, 1])
-                    cb = color_tab[i, 2] + w * (color_tab[i + 1, 2] - color_tab[i, 2])
+                    value = _value(data, flat, nx, nxy, offset, gshape, ux, uy, uz, fkind,
+                                   fp0, fp1, fp2, radius, ntaps, wx, wy, wz)
+                    taken += 1
+                    k += 1
+                    # Classify: segment opacity 1 - exp(-density ds) (eq 1.4) and colour
+                    # E alpha (eq 1.9), from the table.
+                    i, w = lookup((value - tstart) * tinv, ntab)
+                    alpha = alpha_tab[i] + w * (alpha_tab[i + 1] - alpha_tab[i])
+                    if not alpha > 0.0:
+                        continue  # a transparent segment adds exactly nothing
+                    if grey and not by_gradient:
+                        cr = cg = cb = alpha  # white emission, no shading: colour = opacity
+                    elif shade or by_gradient:
+                        gx_, gy_, gz_ = gradient(data, offset, gshape, ux, uy, uz, fkind, fp0,
+                                                 fp1, fp2, radius, ntaps, wx, wy, wz, dx, dy,
+                                                 dz)
+                        if headlight:
+                            lx, ly, lz = -d[0], -d[1], -d[2]
+                        else:
+                            lx, ly, lz = light[0], light[1], light[2]
+                        alpha, cr, cg, cb = classify_by_gradient(
+                            alpha, i, w, emit_tab, gx_ * inv[0], gy_ * inv[1], gz_ * inv[2],
+                            by_gradient, ramp_x, ramp_y, shade, lx, ly, lz, d[0], d[1], d[2],
+                            ka, kd, ks, shininess)
+                        if not alpha > 0.0:
+                            continue
+                    else:
+                        cr = color_tab[i, 0] + w * (color_tab[i + 1, 0] - color_tab[i, 0])
+                        cg = color_tab[i, 1] + w * (color_tab[i + 1, 1] - color_tab[i, 1])
+                        cb = color_tab[i, 2] + w * (color_tab[i + 1, 2] - color_tab[i, 2])
                 if fraction != 1.0:  # a segment cut by the volume's face
                     part = _part_of_segment(alpha, fraction)
                     cr *= part / alpha

@@ -84,3 +84,28 @@ def classify_by_gradient(alpha, i, w, emit_tab, gx, gy, gz, by_gradient, ramp_x,
         return (alpha, (er * lit + spec) * alpha, (eg * lit + spec) * alpha,
                 (eb * lit + spec) * alpha)
     return alpha, er * alpha, eg * alpha, eb * alpha
+
+
+@jit(inline="always")
+def modulate_by_gradient(alpha, r, g, b, gx, gy, gz, by_gradient, ramp_x, ramp_y, shade,
+                         lx, ly, lz, dx, dy, dz, ka, kd, ks, shininess):
+    """A classified segment (opacity ``alpha``, premultiplied colour ``(r, g, b)``, e.g.
+    pre-integrated) modulated by the gradient ``g`` (world units) at its middle: with
+    ``by_gradient`` its density is scaled by the factor of ``|g|`` (``alpha = 1 - (1 -
+    alpha)^factor``, eq 1.4, the colour in proportion), with ``shade`` its colour is
+    Phong-shaded (``colour * factor + highlight * alpha``), as :func:`classify_by_gradient`
+    does for one value. Returns ``(alpha, r, g, b)``."""
+    if by_gradient:
+        factor = piecewise_linear(ramp_x, ramp_y, math.sqrt(gx * gx + gy * gy + gz * gz))
+        if not factor > 0.0:
+            return 0.0, 0.0, 0.0, 0.0
+        if factor < 1.0 and alpha < 1.0:
+            scaled = -math.expm1(factor * math.log1p(-alpha))
+            r *= scaled / alpha
+            g *= scaled / alpha
+            b *= scaled / alpha
+            alpha = scaled
+    if shade:
+        lit, spec = phong(gx, gy, gz, lx, ly, lz, dx, dy, dz, ka, kd, ks, shininess)
+        return alpha, r * lit + spec * alpha, g * lit + spec * alpha, b * lit + spec * alpha
+    return alpha, r, g, b
