@@ -21,7 +21,8 @@ RENDERERS = sorted({fn.__module__ for fn in vrlib.METHODS.values()} | {"vrlib.re
 #: Kernel modules every kernel may use; the renderers' own kernels are not among them.
 SHARED_KERNELS = {"vrlib._kernels._jit", "vrlib._kernels.filters", "vrlib._kernels.sampling",
                   "vrlib._kernels.camera", "vrlib._kernels.tables",
-                  "vrlib._kernels.shading", "vrlib._kernels.footprint"}
+                  "vrlib._kernels.shading", "vrlib._kernels.footprint",
+                  "vrlib._kernels.preintegration"}
 
 
 def module_name(path):
