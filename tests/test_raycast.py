@@ -189,6 +189,23 @@ def test_empty_space_skipping_changes_nothing(filt, transfer):
         assert skipped.stats.samples < 0.5 * full.stats.samples
 
 
+@pytest.mark.parametrize("classification", ["point", "preintegrated"])
+@pytest.mark.parametrize("transfer", [Glow(4.0), TABLE, Glow(3.0, shading=Phong(specular=0.5))],
+                         ids=["glow", "table", "glow-shaded"])
+def test_skipping_by_a_budget_stays_within_it(classification, transfer):
+    """Leaving out blocks that are not empty, while the bounds of those a ray leaves out add
+    up to at most the budget, changes no channel of any pixel by more than the budget, and
+    leaves out samples (a blob with long low tails)."""
+    vol = data_gen.make_field("gaussian-blob", sigma=0.3).sample(40)
+    view = View.orbit(azimuth=25, elevation=35, size=48)
+    full = render(vol, view, transfer=transfer, classification=classification, step=0.5)
+    for budget in (1e-3, 1e-2, 0.1):
+        part = render(vol, view, transfer=transfer, classification=classification, step=0.5,
+                      skip_budget=budget)
+        assert np.abs(part.rgba - full.rgba).max() <= budget
+    assert part.stats.samples < 0.9 * full.stats.samples
+
+
 def test_early_termination_stays_within_its_bound():
     """Stopping at opacity 1 - e changes no channel by more than e (emission <= 1)."""
     vol = data_gen.make_field("smooth-sphere", radius=0.7).sample(32)

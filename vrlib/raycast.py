@@ -21,11 +21,11 @@ from vrlib._kernels.filters import TENT
 from vrlib._scheduling import balanced_order
 from vrlib.image import Image, RenderStats
 from vrlib.prefilter import Tally, prepared
-from vrlib.skipping import BLOCK, coarsen, empty_blocks, footprint_mask, visible_box
+from vrlib.skipping import BLOCK, block_densities, coarsen, footprint_mask, visible_box
 from vrlib.value_bounds import reconstructed_range
 from vrlib.volume import lattice_extent
 
-__all__ = ["render_raycast", "cast_rays", "operations_per_sample"]
+__all__ = ["render_raycast", "cast_rays", "operations_per_sample", "skip_bounds"]
 
 #: Pixels (rows, columns) of the image tiles that the parallel loop hands out.
 TILE = (32, 32)
@@ -60,7 +60,8 @@ CLASSIFICATIONS = ("point", "preintegrated")
 
 
 def render_raycast(volume, view, *, filt, transfer, step, early_termination,
-                   empty_space_skipping, segment_ends=None, classification="point"):
+                   empty_space_skipping, segment_ends=None, classification="point",
+                   skip_budget=0.0):
     """Ray-cast ``volume`` (arguments already validated by :func:`vrlib.render`).
 
     ``segment_ends="lattice"`` lets every sample stand for a whole step, also where the
@@ -76,7 +77,12 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
     steep transfer functions are then not aliased. It takes the field as linear along a
     segment (a step at its middle with the box filter); gradient opacity and shading use the
     gradient at the segment's middle (docs/kernel.md).
+
+    ``skip_budget`` (>= 0, premultiplied colour units) lets each ray leave out blocks that
+    are not empty, while the most those blocks could change any channel of its pixel
+    (:func:`skip_bounds`) adds up to at most the budget; 0 skips only empty blocks.
     """
+    skip_budget = validate.finite_number("skip_budget", skip_budget, low=0.0)
     validate.choice("classification", classification, CLASSIFICATIONS)
     preint = classification == "preintegrated"
     if segment_ends is None:
@@ -96,10 +102,17 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
     extent = volume.extent
     box_lo, box_hi = extent[:, 0].copy(), extent[:, 1].copy()
     ds = step * float(volume.spacing.min())
-    skip = None
+    skip = bound = None
+    if skip_budget > 0.0 and not empty_space_skipping:
+        raise ValueError("skip_budget > 0 skips blocks: it needs empty_space_skipping=True")
     if empty_space_skipping:
-        empty = empty_blocks(volume, filt, transfer, block=BLOCK)
-        if empty.any():  # with nothing to skip, checking would only cost time
+        densities = block_densities(volume, filt, transfer, block=BLOCK)
+        empty = densities <= 0.0
+        if skip_budget > 0.0:
+            bound = skip_bounds(densities, volume, transfer, ds, reconstructed_range(volume,
+                                                                                   filt))
+        # With nothing to skip, checking would only cost time.
+        if empty.any() or (bound is not None and np.any(bound <= skip_budget)):
             box_lo, box_hi = visible_box(volume, empty, BLOCK, box_lo, box_hi)
             if preint:  # a segment owned outside the box reaches half a step into it
                 box_lo = np.maximum(box_lo - 0.5 * ds, extent[:, 0])
@@ -110,7 +123,7 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
         spacing=volume.spacing, box=(box_lo, box_hi), view=view, filt=filt, transfer=transfer,
         ds=ds, value_range=reconstructed_range(volume, filt),
         early_termination=early_termination, skip=skip, exact_ends=segment_ends == "exact",
-        preintegrated=preint,
+        preintegrated=preint, bound=bound, budget=skip_budget,
     )
     stats = RenderStats(
         samples=taken,
@@ -121,9 +134,37 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
     return Image(rgba, tally.finish(stats, filt))
 
 
+def skip_bounds(densities, volume, transfer, ds, value_range):
+    """The most leaving one block out can change any channel of a pixel, per block.
+
+    A block of largest density ``Omega`` (:func:`vrlib.skipping.block_densities`) gives the
+    samples a ray takes in it at most opacity ``a = 1 - exp(-Omega l)``, with ``l`` the
+    block's diagonal plus one step ``ds`` (the segments whose samples lie in it). Leaving them
+    out changes the pixel by their own light, at most ``E a``, less the light they hid, at
+    most ``E a`` again, two non-negative amounts: by at most ``E a``, with ``E`` the
+    brightest channel any sample can send (the emission's largest value, lit and
+    highlighted; 1 for opacity). Bounds of several blocks add.
+
+    Examples
+    --------
+    >>> from vrlib import Glow, Volume
+    >>> vol = Volume(np.zeros((9, 9, 9)))
+    >>> b = skip_bounds(np.array([[[0.0, 1.0]]]), vol, Glow(1.0), 0.1, (0.0, 1.0))
+    >>> b.round(4).tolist()          # diagonal of 8 cells of 0.25: 3.4641, plus the step
+    [[[0.0, 0.9716]]]
+    """
+    diagonal = float(np.linalg.norm(BLOCK * volume.spacing)) + ds
+    _, _, _, emission = transfer.value_table(*value_range)
+    brightest = float(emission.max())
+    shading = transfer.shading
+    if shading is not None:
+        brightest = brightest * (shading.ambient + shading.diffuse) + shading.specular
+    return max(1.0, brightest) * -np.expm1(-densities * diagonal)
+
+
 def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, transfer, ds,
               value_range, early_termination, skip=None, exact_ends=False,
-              preintegrated=False):
+              preintegrated=False, bound=None, budget=0.0):
     """Ray-cast samples ``data`` (all of a volume, or a brick of it with ghost samples): the
     ray caster's core, which the MPI renderers run on each brick or tile.
 
@@ -148,6 +189,10 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
         Classify each segment from its values at its two ends (needs ``exact_ends``; the
         box filter takes the value as a step at the segment's middle). A brick then needs
         ghost samples half a step beyond its box as well.
+    bound : ndarray or None
+        Per block of the skip grid, the most leaving it out can change a pixel
+        (:func:`skip_bounds`); with ``budget > 0`` a ray leaves blocks out while their
+        bounds add up to at most ``budget``.
 
     Returns
     -------
@@ -193,6 +238,7 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
         view.height, view.width,
         ds, *filt.code, filt.radius, filt.taps, *tables, *lighting, *by_gradient,
         early_termination, *skip,
+        np.zeros((1, 1, 1)) if bound is None else bound, float(budget),
         *TILE, balanced_order(costs, numba.get_num_threads()), out, samples, grey,
         bool(preintegrated), *pre,
     )

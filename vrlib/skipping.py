@@ -18,11 +18,30 @@ import numpy as np
 
 from vrlib.value_bounds import value_bounds
 
-__all__ = ["BLOCK", "empty_blocks", "brick_empty_blocks", "coarsen", "visible_box",
-           "footprint_mask", "transparent_runs"]
+__all__ = ["BLOCK", "block_densities", "empty_blocks", "brick_empty_blocks", "coarsen",
+           "visible_box", "footprint_mask", "transparent_runs"]
 
 #: Cells per block (each axis) of the empty-space skipping grid.
 BLOCK = 8
+
+
+def block_densities(volume, filt, transfer, *, block=8):
+    """The largest opacity density the filter can reconstruct in each level-0 block of
+    ``volume`` (per world unit; 0 where nothing shows): what :func:`empty_blocks` tests
+    against zero, and what skipping by an error budget bounds a block's light with.
+
+    Examples
+    --------
+    >>> from vrlib import Volume, Glow, make_filter
+    >>> data = np.zeros((17, 17, 17)); data[12, 12, 12] = 1.0
+    >>> dens = block_densities(Volume(data), make_filter("trilinear"), Glow(2.0), block=8)
+    >>> float(dens.max()), int((dens > 0).sum())
+    (2.0, 1)
+    """
+    pyr = volume.minmax_pyramid(block, margin=filt.margin)
+    low, high = value_bounds(pyr.minimum[0].astype(np.float64),
+                             pyr.maximum[0].astype(np.float64), filt)
+    return np.asarray(transfer.max_density(low, high), dtype=np.float64)
 
 
 def empty_blocks(volume, filt, transfer, *, block=8):
@@ -44,10 +63,7 @@ def empty_blocks(volume, filt, transfer, *, block=8):
     >>> empty.shape, int(empty.sum())
     ((2, 2, 2), 7)
     """
-    pyr = volume.minmax_pyramid(block, margin=filt.margin)
-    low, high = value_bounds(pyr.minimum[0].astype(np.float64),
-                             pyr.maximum[0].astype(np.float64), filt)
-    return np.asarray(transfer.max_density(low, high)) <= 0.0
+    return block_densities(volume, filt, transfer, block=block) <= 0.0
 
 
 def brick_empty_blocks(data, first, lo, hi, cells, filt, transfer, *, block=BLOCK):

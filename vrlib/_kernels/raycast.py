@@ -60,6 +60,12 @@ def _is_empty(empty, cells, ux, uy, uz):
 
 
 @jit
+def _block_bound(bound, cells, ux, uy, uz):
+    return bound[_cell(uz, cells, bound.shape[0]), _cell(uy, cells, bound.shape[1]),
+                 _cell(ux, cells, bound.shape[2])]
+
+
+@jit
 def _exit(ax, ay, az, bx, by, bz, cells, counts, ux, uy, uz):
     """Ray parameter where the ray (index position ``a + t b``) leaves the block that holds
     ``(ux, uy, uz)`` on a grid of ``cells``-cell blocks (``counts`` blocks per axis, z y x)."""
@@ -88,11 +94,12 @@ def _part_of_segment(alpha, fraction):
     return -math.expm1(fraction * math.log1p(-alpha)) if alpha < 1.0 else 1.0
 
 
-@jit(inline="always")
-def _value(data, flat, nx, nxy, offset, gshape, ux, uy, uz, fkind, fp0, fp1, fp2, radius,
-           ntaps, wx, wy, wz):
-    """The reconstructed value at global index position ``(ux, uy, uz)``: the two common
-    filters unrolled, the others through the general loop."""
+@jit
+def _sample(data, flat, nx, nxy, offset, gshape, ux, uy, uz, fkind, fp0, fp1, fp2, radius,
+            ntaps, wx, wy, wz):
+    """The reconstructed value at global index position ``(ux, uy, uz)``, as the point
+    sampling loop computes it inline, as a call: the pre-integrated path's reconstructions
+    then leave that loop as small (and fast) as it was."""
     if fkind == TENT:
         return trilinear(flat, nx, nxy, offset[0], offset[1], offset[2], gshape[0], gshape[1],
                          gshape[2], ux, uy, uz)
@@ -106,13 +113,48 @@ def _value(data, flat, nx, nxy, offset, gshape, ux, uy, uz, fkind, fp0, fp1, fp2
                        wx, wy, wz)
 
 
+@jit
+def _preintegrated(front, back, length, start, inv, density, psi, emission, step, grey,
+                   col_start, col_inv, mean):
+    """Opacity and premultiplied colour ``(alpha, r, g, b)`` of a segment of ``length`` from
+    its front and back values (:class:`vrlib.transfer.PreintegratedTable`)."""
+    if step:
+        # A step at the middle (the box filter): half a segment at the front value over
+        # half at the back value, exactly.
+        half_a = -math.expm1(-0.5 * length * interpolate(density, start, inv, front))
+        half_b = -math.expm1(-0.5 * length * interpolate(density, start, inv, back))
+        alpha = 1.0 - (1.0 - half_a) * (1.0 - half_b)
+        if grey or not alpha > 0.0:
+            return alpha, alpha, alpha, alpha
+        behind = (1.0 - half_a) * half_b
+        return (alpha,
+                half_a * interpolate_channel(emission, start, inv, front, 0)
+                + behind * interpolate_channel(emission, start, inv, back, 0),
+                half_a * interpolate_channel(emission, start, inv, front, 1)
+                + behind * interpolate_channel(emission, start, inv, back, 1),
+                half_a * interpolate_channel(emission, start, inv, front, 2)
+                + behind * interpolate_channel(emission, start, inv, back, 2))
+    # A linear ramp: the opacity exact from the density's running integral, the colour from
+    # the (front, back) table of the segment's mean emission.
+    alpha = -math.expm1(-length * mean_density(front, back, start, inv, density, psi))
+    if grey or not alpha > 0.0:
+        return alpha, alpha, alpha, alpha
+    px = (front - col_start) * col_inv
+    py = (back - col_start) * col_inv
+    n = mean.shape[0]
+    return (alpha, alpha * bilinear_channel(mean, px, py, n, 0),
+            alpha * bilinear_channel(mean, px, py, n, 1),
+            alpha * bilinear_channel(mean, px, py, n, 2))
+
+
 @parallel_jit
 def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_hi, exact,
             camera, height, width, ds,
             fkind, fp0, fp1, fp2, radius, ntaps,
             tstart, tinv, alpha_tab, color_tab, emit_tab,
             shade, ka, kd, ks, shininess, light, headlight, ramp_x, ramp_y, by_gradient,
-            threshold, empty, coarse, block, mask, tile_h, tile_w, order, out, samples, grey,
+            threshold, empty, coarse, block, mask, bound, budget, tile_h, tile_w, order, out,
+            samples, grey,
             preint, pre_start, pre_inv, pre_density, pre_psi, pre_emission, pre_step, pre_grey,
             col_start, col_inv, pre_mean):
     """Render ``out[row, col] = (r, g, b, a)`` premultiplied; count samples per tile.
@@ -130,7 +172,10 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
     Skips: ``empty`` flags blocks of ``block`` cells per axis that nothing visible can come
     from, and ``coarse`` blocks of ``4 * block`` cells all of whose blocks are empty
     (``block = 0`` turns skipping off), and ``mask`` the pixels whose rays can meet a
-    non-empty block; ``threshold = 1`` turns early ray termination off.
+    non-empty block; ``threshold = 1`` turns early ray termination off. With ``budget > 0``
+    a ray also skips blocks that are not empty while the bounds ``bound`` (per block: the
+    most a ray can change any channel by leaving the block out) of the blocks it skipped add
+    up to at most ``budget``: each pixel changes by at most ``budget``.
     ``grey`` says the emission is 1 everywhere and unshaded, so colour equals opacity.
     ``preint`` classifies each segment from its values at its two ends instead of its
     middle's value: the opacity from the mean density (``pre_density`` and its running
@@ -155,7 +200,8 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
             box_lo, box_hi, vol_lo, vol_hi, exact, camera, height, width,
             ds, fkind, fp0, fp1, fp2, radius, ntaps, tstart, tinv, alpha_tab, color_tab,
             emit_tab, shade, ka, kd, ks, shininess, light, headlight, ramp_x, ramp_y,
-            by_gradient, threshold, empty, coarse, block, mask, tile_h, tile_w, out, grey,
+            by_gradient, threshold, empty, coarse, block, mask, bound, budget, tile_h, tile_w,
+            out, grey,
             preint, pre_start, pre_inv, pre_density, pre_psi, pre_emission, pre_step, pre_grey,
             col_start, col_inv, pre_mean)
 
@@ -165,8 +211,9 @@ def _tile(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, 
           box_lo, box_hi, vol_lo, vol_hi, exact, camera, height, width, ds, fkind, fp0, fp1, fp2,
           radius, ntaps, tstart, tinv, alpha_tab, color_tab, emit_tab, shade, ka, kd, ks,
           shininess, light, headlight, ramp_x, ramp_y, by_gradient, threshold, empty, coarse,
-          block, mask, tile_h, tile_w, out, grey, preint, pre_start, pre_inv, pre_density,
-          pre_psi, pre_emission, pre_step, pre_grey, col_start, col_inv, pre_mean):
+          block, mask, bound, budget, tile_h, tile_w, out, grey, preint, pre_start, pre_inv,
+          pre_density, pre_psi, pre_emission, pre_step, pre_grey, col_start, col_inv,
+          pre_mean):
     """Tile ``tile_id`` of :func:`raycast` (the same arguments): its pixels' rays, front to
     back, in a fixed order; returns the samples taken. ``flat`` is ``data`` raveled, ``inv``
     the inverse spacing, ``fine_counts`` and ``coarse_counts`` the skip grids' shapes."""
@@ -176,7 +223,6 @@ def _tile(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, 
     oz, oy, ox = offset[0], offset[1], offset[2]
     gz, gy, gx = gshape[0], gshape[1], gshape[2]
     ntab = alpha_tab.shape[0]
-    npre = pre_mean.shape[0]
     plain = (fkind == TENT and grey and not shade and not by_gradient and block == 0
              and not preint)
     row0 = (tile_id // tiles_across) * tile_h
@@ -222,6 +268,7 @@ def _tile(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, 
             k_last = math.ceil(t_last / ds) - 1
             if k - 1 == k_first or k - 1 == k_last:
                 k -= 1
+        spent = 0.0  # the budget's share this ray has used
         k_front = -1  # the segment whose front value `front` holds (pre-integration)
         front = 0.0
         if plain:
@@ -281,7 +328,17 @@ def _tile(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, 
                 cy = ay + tc * by
                 cz = az + tc * bz
                 if tc >= t_check and not _is_empty(empty, block, cx, cy, cz):
-                    t_check = _exit(ax, ay, az, bx, by, bz, block, fine_counts, cx, cy, cz)
+                    t_exit = _exit(ax, ay, az, bx, by, bz, block, fine_counts, cx, cy, cz)
+                    cost = _block_bound(bound, block, cx, cy, cz) if budget > 0.0 else 0.0
+                    if budget > 0.0 and spent + cost <= budget:
+                        # Skipping by the error budget: leave out what this block could add.
+                        spent += cost
+                        if preint:
+                            k = max(math.ceil(t_exit / ds), k + 1)
+                        else:
+                            k = max(math.ceil(t_exit / ds - 0.5), k + 1)
+                        continue
+                    t_check = t_exit
                 elif tc >= t_check:
                     # Jump past the largest empty block here, then step back over any
                     # sample that rounding placed in a block that is not empty: the image
@@ -323,13 +380,13 @@ def _tile(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, 
                     if fraction != 1.0:
                         t_b = min(t_b, t_last)
                     if k != k_front:
-                        front = _value(data, flat, nx, nxy, offset, gshape, ax + t_a * bx,
-                                       ay + t_a * by, az + t_a * bz, fkind, fp0, fp1, fp2,
-                                       radius, ntaps, wx, wy, wz)
+                        front = _sample(data, flat, nx, nxy, offset, gshape, ax + t_a * bx,
+                                        ay + t_a * by, az + t_a * bz, fkind, fp0, fp1, fp2,
+                                        radius, ntaps, wx, wy, wz)
                         taken += 1
-                    back = _value(data, flat, nx, nxy, offset, gshape, ax + t_b * bx,
-                                  ay + t_b * by, az + t_b * bz, fkind, fp0, fp1, fp2, radius,
-                                  ntaps, wx, wy, wz)
+                    back = _sample(data, flat, nx, nxy, offset, gshape, ax + t_b * bx,
+                                   ay + t_b * by, az + t_b * bz, fkind, fp0, fp1, fp2, radius,
+                                   ntaps, wx, wy, wz)
                     taken += 1
                     # A cut segment's own length: its opacity is exact, its colour's mean
                     # emission that of a whole segment.
@@ -337,41 +394,9 @@ def _tile(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, 
                     if fraction != 1.0:
                         length = t_b - t_a
                         fraction = 1.0
-                    if pre_step:
-                        # A step at the middle (the box filter): half a segment at the front
-                        # value over half at the back value, exactly.
-                        half_a = -math.expm1(-0.5 * length * interpolate(
-                            pre_density, pre_start, pre_inv, front))
-                        half_b = -math.expm1(-0.5 * length * interpolate(
-                            pre_density, pre_start, pre_inv, back))
-                        alpha = 1.0 - (1.0 - half_a) * (1.0 - half_b)
-                        cr = cg = cb = alpha
-                        if alpha > 0.0 and not pre_grey:
-                            cr = half_a * interpolate_channel(pre_emission, pre_start, pre_inv,
-                                                              front, 0) \
-                                + (1.0 - half_a) * half_b * interpolate_channel(
-                                    pre_emission, pre_start, pre_inv, back, 0)
-                            cg = half_a * interpolate_channel(pre_emission, pre_start, pre_inv,
-                                                              front, 1) \
-                                + (1.0 - half_a) * half_b * interpolate_channel(
-                                    pre_emission, pre_start, pre_inv, back, 1)
-                            cb = half_a * interpolate_channel(pre_emission, pre_start, pre_inv,
-                                                              front, 2) \
-                                + (1.0 - half_a) * half_b * interpolate_channel(
-                                    pre_emission, pre_start, pre_inv, back, 2)
-                    else:
-                        # A linear ramp: the opacity exact from the density's running
-                        # integral, the colour from the (front, back) table of the
-                        # segment's mean emission.
-                        alpha = -math.expm1(-length * mean_density(
-                            front, back, pre_start, pre_inv, pre_density, pre_psi))
-                        cr = cg = cb = alpha
-                        if alpha > 0.0 and not pre_grey:
-                            px = (front - col_start) * col_inv
-                            py = (back - col_start) * col_inv
-                            cr = alpha * bilinear_channel(pre_mean, px, py, npre, 0)
-                            cg = alpha * bilinear_channel(pre_mean, px, py, npre, 1)
-                            cb = alpha * bilinear_channel(pre_mean, px, py, npre, 2)
+                    alpha, cr, cg, cb = _preintegrated(
+                        front, back, length, pre_start, pre_inv, pre_density, pre_psi,
+                        pre_emission, pre_step, pre_grey, col_start, col_inv, pre_mean)
                     front = back
                     k += 1
                     k_front = k
@@ -393,8 +418,18 @@ def _tile(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, 
                         if not alpha > 0.0:
                             continue
                 else:
-                    value = _value(data, flat, nx, nxy, offset, gshape, ux, uy, uz, fkind,
-                                   fp0, fp1, fp2, radius, ntaps, wx, wy, wz)
+                    # The two common filters unrolled, the others through the general loop.
+                    if fkind == TENT:
+                        value = trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz)
+                    elif fkind == CUBIC:
+                        value = tricubic(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz,
+                                         fp0, fp1, fp2)
+                    elif ntaps == 4:
+                        value = separable4(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz,
+                                           fkind, fp0, fp1, fp2, radius)
+                    else:
+                        value = reconstruct(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1,
+                                            fp2, radius, ntaps, wx, wy, wz)
                     taken += 1
                     k += 1
                     # Classify: segment opacity 1 - exp(-density ds) (eq 1.4) and colour
