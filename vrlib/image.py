@@ -43,12 +43,15 @@ class RenderStats:
         ``operations`` and ``samples`` filtered in this render (included in the totals above;
         0, and ``cached`` True, when every coefficient it needed was kept from before), and
         ``kept_seconds``, the part spent on coefficients kept with the volume.
+    choices : dict or None
+        A render to a tolerance (``render(..., tolerance=t)``, :mod:`vrlib.tolerance`): what
+        it chose (step, classification, budgets), its pilot, and its estimated error.
 
     Examples
     --------
     >>> RenderStats(samples=10, seconds=0.5).as_dict()     # doctest: +NORMALIZE_WHITESPACE
     {'samples': 10, 'operations': 0, 'bytes': 0, 'seconds': 0.5, 'voxels': 0, 'passes': None,
-     'points': 10, 'prefilter': None}
+     'points': 10, 'prefilter': None, 'choices': None}
     """
 
     samples: int = 0
@@ -59,6 +62,7 @@ class RenderStats:
     passes: dict | None = None
     points: int | None = None
     prefilter: dict | None = None
+    choices: dict | None = None
 
     def __post_init__(self):
         if self.points is None:

@@ -25,7 +25,8 @@ from vrlib.skipping import BLOCK, block_densities, coarsen, footprint_mask, visi
 from vrlib.value_bounds import reconstructed_range
 from vrlib.volume import lattice_extent
 
-__all__ = ["render_raycast", "cast_rays", "operations_per_sample", "skip_bounds"]
+__all__ = ["render_raycast", "cast_rays", "operations_per_sample", "skip_bounds",
+           "brightest"]
 
 #: Pixels (rows, columns) of the image tiles that the parallel loop hands out.
 TILE = (32, 32)
@@ -154,12 +155,26 @@ def skip_bounds(densities, volume, transfer, ds, value_range):
     [[[0.0, 0.9716]]]
     """
     diagonal = float(np.linalg.norm(BLOCK * volume.spacing)) + ds
+    return brightest(transfer, value_range) * -np.expm1(-densities * diagonal)
+
+
+def brightest(transfer, value_range):
+    """The most light a segment can send in any channel per unit of its opacity: the
+    emission's largest value over ``value_range``, lit and highlighted at most as brightly as
+    the shading allows, and at least 1 (the alpha channel's).
+
+    Examples
+    --------
+    >>> from vrlib import Glow, Phong
+    >>> brightest(Glow(1.0, shading=Phong(ambient=0.3, diffuse=0.7, specular=0.5)), (0, 1))
+    1.5
+    """
     _, _, _, emission = transfer.value_table(*value_range)
-    brightest = float(emission.max())
+    most = float(emission.max())
     shading = transfer.shading
     if shading is not None:
-        brightest = brightest * (shading.ambient + shading.diffuse) + shading.specular
-    return max(1.0, brightest) * -np.expm1(-densities * diagonal)
+        most = most * (shading.ambient + shading.diffuse) + shading.specular
+    return max(1.0, most)
 
 
 def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, transfer, ds,

@@ -15,6 +15,7 @@ from vrlib.reference import render_reference
 from vrlib.shear import render_shear2, render_shear3
 from vrlib.shearwarp import render_shearwarp
 from vrlib.splat import render_splat
+from vrlib.tolerance import render_within
 from vrlib.volume import Volume
 
 __all__ = ["render", "METHODS", "method_options", "reference_image"]
@@ -45,17 +46,18 @@ def method_options(method):
             if p.kind is p.KEYWORD_ONLY and p.name not in _COMMON}
 
 
-def render(volume, view, *, method="raycast", filter="trilinear", transfer=None, step=0.5,
-           early_termination=0.999, empty_space_skipping=True, blend="emission-absorption",
-           threads=None, **options):
+def render(volume, view, *, method="raycast", filter="trilinear", transfer=None, step=None,
+           early_termination=None, empty_space_skipping=True, blend="emission-absorption",
+           threads=None, tolerance=None, **options):
     """Render a volume into an image.
 
     Parameters
     ----------
     volume : Volume
     view : View
-    method : {"raycast", "splat", "shear3", "shear2", "shearwarp"}
-        The rendering method (see :data:`METHODS`).
+    method : {"raycast", "splat", "shear3", "shear2", "shearwarp", "auto"}
+        The rendering method (see :data:`METHODS`). ``"auto"`` picks one for you: ray
+        casting, the one method that renders to a tolerance, for now.
     filter : str, tuple or Filter, default "trilinear"
         Reconstruction filter, by name or built with :func:`vrlib.make_filter`. Trilinear is
         the default here and on the command line because it is the fastest; ``"catmull-rom"``
@@ -82,6 +84,15 @@ def render(volume, view, *, method="raycast", filter="trilinear", transfer=None,
         the mean value along each ray (:mod:`vrlib.projection`; ray casting only, no shading).
     threads : int, optional
         Threads to use (default: numba's setting). The image does not depend on it.
+    tolerance : float, optional
+        Render an image whose rmse (premultiplied RGBA) against the exact image of the field
+        the filter reconstructs (:class:`vrlib.ReconstructedField` rendered by
+        :func:`vrlib.render_reference`) is at most this, in (0, 1): the step, the
+        classification and the early termination are then chosen for it
+        (:mod:`vrlib.tolerance`), and ``img.stats.choices`` says what was chosen and the
+        error expected. Ray casting only (``method="raycast"`` or ``"auto"``); leave
+        ``step`` and ``early_termination`` out. ``None`` (default) renders with the step
+        and settings given, exactly as without it.
     **options
         Options of the chosen method (:func:`method_options` lists them): for ``"splat"``,
         ``mode`` ("sheet", "image-aligned" or "direct"), ``footprint_resolution`` and
@@ -110,9 +121,14 @@ def render(volume, view, *, method="raycast", filter="trilinear", transfer=None,
         hint = ("; a ClassifiedVolume renders with its own .render(view)"
                 if type(volume).__name__ == "ClassifiedVolume" else "")
         raise TypeError(f"volume must be a vrlib.Volume, got {type(volume).__name__}{hint}")
-    validate.choice("method", method, tuple(METHODS))
+    validate.choice("method", method, (*METHODS, "auto"))
     if isinstance(transfer, str) and transfer == "auto":
         transfer = auto_transfer(volume)
+    if tolerance is not None:
+        _check_tolerance_arguments(method, step, early_termination, blend, options)
+    method = "raycast" if method == "auto" else method
+    step = 0.5 if step is None else step
+    early_termination = 0.999 if early_termination is None else early_termination
     filt, transfer, step, early_termination = render_arguments(view, filter, transfer, step,
                                                                early_termination)
     view = framed_view(view, volume.extent, transfer, volume.value_range)
@@ -132,6 +148,11 @@ def render(volume, view, *, method="raycast", filter="trilinear", transfer=None,
         with thread_count(threads):
             return render_projection(volume, view, filt=filt, transfer=transfer, step=step,
                                      blend=blend)
+    if tolerance is not None:
+        with thread_count(threads):
+            return render_within(volume, view, filt=filt, transfer=transfer,
+                                 tolerance=tolerance,
+                                 empty_space_skipping=empty_space_skipping)
     allowed = method_options(method)
     unknown = sorted(set(options) - set(allowed))
     if unknown:
@@ -141,6 +162,22 @@ def render(volume, view, *, method="raycast", filter="trilinear", transfer=None,
         return METHODS[method](volume, view, filt=filt, transfer=transfer, step=step,
                                early_termination=early_termination,
                                empty_space_skipping=empty_space_skipping, **options)
+
+
+def _check_tolerance_arguments(method, step, early_termination, blend, options):
+    """Refuse what a render to a tolerance chooses itself, or cannot do."""
+    if method not in ("raycast", "auto"):
+        raise ValueError(f"tolerance= is kept by ray casting only: use method='raycast' or "
+                         f"method='auto' (not {method!r}), or leave tolerance out")
+    given = [name for name, value in (("step", step), ("early_termination",
+                                                       early_termination)) if value is not None]
+    given += sorted(options)
+    if given:
+        raise ValueError(f"tolerance= chooses {', '.join(given)} itself: leave "
+                         f"{'it' if len(given) == 1 else 'them'} out, or leave tolerance out")
+    if blend != "emission-absorption":
+        raise ValueError(f"tolerance= is kept for blend='emission-absorption' only, not "
+                         f"{blend!r}")
 
 
 def reference_image(volume, view, *, transfer=None, field=None):

@@ -201,6 +201,21 @@ class View:
                     radius=_radius_of(box), projection=self.projection, zoom=self.zoom,
                     fov=self._given["fov"], distance=self._given["distance"])
 
+    def resized(self, size):
+        """This view with ``size`` pixels (``n`` or ``(height, width)``) over the same image:
+        the same framing, larger or smaller pixels (a preview, a pilot render).
+
+        Examples
+        --------
+        >>> view = View.orbit(azimuth=30, size=64, radius=1.0)
+        >>> small = view.resized(16)
+        >>> small.shape, round(small.pixel_size / view.pixel_size, 6)
+        ((16, 16), 4.0)
+        """
+        return View(self.forward, self._given["up"], size=size, center=self.center,
+                    radius=self.radius, projection=self.projection, zoom=self.zoom,
+                    fov=self.fov if self.is_perspective else None, distance=self.distance)
+
     def sees(self, extent):
         """Whether any part of the world box ``extent`` projects into the image.
 

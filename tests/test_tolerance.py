@@ -1,0 +1,89 @@
+"""Rendering to a tolerance: the promise kept against the exact image of the reconstructed
+field, what is chosen, and what is refused."""
+
+import numpy as np
+import pytest
+
+import data_gen
+import vrlib
+from vrlib import Glow, LookupTransfer, View, metrics, render, render_reference
+
+
+def steep(volume):
+    """A narrow opacity peak, 3% of the value range wide: what point sampling aliases."""
+    grid = np.linspace(0.0, 1.0, 1001)
+    return LookupTransfer(40.0 * np.clip(1.0 - np.abs(grid - 0.6) / 0.015, 0.0, None),
+                          value_range=volume.value_range)
+
+
+@pytest.mark.parametrize("scene", ["marschner-lobb", "steep", "floor"])
+@pytest.mark.parametrize("tolerance", [1e-2, 1e-3])
+def test_the_promise_is_kept(scene, tolerance):
+    """rmse against the exact image of the field the filter reconstructs is at most the
+    tolerance, and the estimate the render reports is within a factor of 3 of it (the
+    chapter on time against error measures 45 cases; these are the quick ones)."""
+    vol = data_gen.make_field("marschner-lobb").sample(25)
+    transfer = Glow(1.0)
+    if scene == "steep":
+        transfer = steep(vol)
+    elif scene == "floor":
+        blob = data_gen.make_field("gaussian-blob", sigma=0.25).sample(25)
+        vol = vrlib.Volume(blob.data + 0.3, blob.extent)
+    view = View.orbit(azimuth=30, elevation=20, size=40)
+    exact = render_reference(vrlib.ReconstructedField(vol), view, transfer=transfer, tol=1e-8)
+    img = render(vol, view, transfer=transfer, tolerance=tolerance)
+    error = metrics.rmse(img, exact)
+    assert error <= tolerance
+    choices = img.stats.choices
+    assert choices["estimate"] <= tolerance
+    assert error <= 3.0 * choices["estimate"]
+    assert choices["method"] == "raycast" and choices["segment_ends"] == "exact"
+
+
+def test_a_smaller_tolerance_takes_a_smaller_step():
+    vol = data_gen.make_field("marschner-lobb").sample(25)
+    view = View.orbit(azimuth=30, elevation=20, size=40)
+    steps = [render(vol, view, tolerance=t).stats.choices["step"] for t in (1e-2, 1e-3, 1e-4)]
+    assert steps[0] >= steps[1] > steps[2]
+
+
+def test_method_auto_is_ray_casting():
+    vol = data_gen.make_field("gaussian-blob").sample(12)
+    view = View.orbit(size=16)
+    img = render(vol, view, method="auto", tolerance=1e-3)
+    assert img.stats.choices["method"] == "raycast"
+    assert np.array_equal(render(vol, view, method="auto").rgba, render(vol, view).rgba)
+
+
+def test_without_a_tolerance_nothing_changes():
+    """tolerance=None renders with the given settings, bit for bit as a render without it."""
+    vol = data_gen.make_field("marschner-lobb").sample(17)
+    view = View.orbit(size=24)
+    plain = render(vol, view, step=0.5, early_termination=0.999)
+    assert np.array_equal(render(vol, view, tolerance=None).rgba, plain.rgba)
+    assert plain.stats.choices is None
+
+
+@pytest.mark.parametrize("options, message", [
+    ({"method": "splat"}, "ray casting only"),
+    ({"step": 0.5}, "chooses step"),
+    ({"early_termination": 0.9}, "chooses early_termination"),
+    ({"classification": "point"}, "chooses classification"),
+    ({"blend": "maximum"}, "emission-absorption"),
+    ({"tolerance": 0.0}, "tolerance"),
+    ({"tolerance": 1.5}, "tolerance"),
+    ({"tolerance": float("nan")}, "tolerance"),
+])
+def test_what_a_tolerance_refuses(options, message):
+    vol = data_gen.make_field("gaussian-blob").sample(12)
+    arguments = {"tolerance": 1e-3, **options}
+    with pytest.raises(ValueError, match=message):
+        render(vol, View.orbit(size=8), **arguments)
+
+
+def test_an_unreachable_tolerance_is_refused_with_what_is_reachable():
+    """A narrow peak on a coarse volume at 1e-7: the step it needs lies below 1/256 voxel,
+    and the error there is named instead of an image returned."""
+    vol = data_gen.make_field("marschner-lobb").sample(13)
+    with pytest.raises(ValueError, match=r"out of reach .* at least"):
+        render(vol, View.orbit(size=16), transfer=steep(vol), tolerance=1e-7)
