@@ -48,6 +48,22 @@ def test_render_npy_matches_the_python_api(tmp_path):
     np.testing.assert_array_equal(np.load(out), expected.rgba)
 
 
+def test_render_to_a_tolerance_matches_the_python_api(tmp_path):
+    """--tolerance renders as render(..., tolerance=) does and says what it chose."""
+    import data_gen
+    import vrlib
+
+    out = tmp_path / "ml.npy"
+    done = run("render", "marschner-lobb:17", "--tolerance", "1e-3", "--size", "24", "-o",
+               str(out))
+    assert done.returncode == 0, done.stderr
+    assert "to rmse 0.001 (step" in done.stdout and "estimated error" in done.stdout
+    vol = data_gen.make_field("marschner-lobb").sample(17)
+    view = vrlib.View.orbit(azimuth=30, elevation=20, size=24)
+    expected = vrlib.render(vol, view, tolerance=1e-3)
+    np.testing.assert_array_equal(np.load(out), expected.rgba)
+
+
 def test_render_classified_matches_the_python_api(tmp_path):
     """``--classified`` is :func:`vrlib.classify` and its render, shading included."""
     import data_gen
@@ -103,6 +119,11 @@ def test_render_reads_files(tmp_path):
     (["turntable", "gaussian-blob:8", "-o", "missing/x.gif"], "no folder"),
     (["compare", "gaussian-blob:8", "-o", "missing/x.png"], "no folder"),
     (["render", "marschner-lobb:3000", "-o", "x.png"], "samples per axis fit"),
+    (["render", "gaussian-blob:8", "--tolerance", "1e-3", "--step", "1", "-o", "x.png"],
+     "leave out --step"),
+    (["render", "gaussian-blob:8", "--tolerance", "1e-3", "--method", "splat", "-o",
+      "x.png"], "use --method raycast or --method auto"),
+    (["render", "gaussian-blob:8", "--tolerance", "2", "-o", "x.png"], "tolerance"),
 ])
 def test_bad_input_exits_2_with_one_line(tmp_path, args, message):
     done = run(*args, cwd=tmp_path)

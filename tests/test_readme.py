@@ -91,6 +91,13 @@ def test_readme_reconstruction_example_prints_what_it_says(capsys):
         ("catmull-rom", 0.0219), ("cardinal-bspline", 0.0132), ("omoms", 0.0103)]
 
 
+def test_readme_tolerance_example_prints_what_it_says(capsys):
+    """The tolerance example's comment: a step over half a voxel meets 1e-3 on this volume
+    (chosen about 1 voxel), and the estimate is within the tolerance."""
+    exec(compile(blocks("python")[5], "README.md", "exec"), {})
+    assert capsys.readouterr().out.split() == ["True", "True"]
+
+
 def test_readme_pictures_are_what_their_commands_make(tmp_path):
     import imageio.v3 as iio
 

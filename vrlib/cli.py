@@ -281,7 +281,7 @@ def _add_scene(parser):
                         choices=["orthographic", "perspective"])
     parser.add_argument("--zoom", type=float, default=1.0,
                         help="magnification; at 1 the image spans the volume's bounding sphere")
-    parser.add_argument("--step", type=float, default=0.5,
+    parser.add_argument("--step", type=float, default=None,
                         help="sample spacing along rays, in voxels (default 0.5)")
 
 
@@ -313,10 +313,26 @@ def cmd_render(args):
         scene = vrlib.classify(volume, transfer)
         seconds, img = measure(partial(scene.render, view), repeats=1, warmup=False)
         what = f"classified shear-warp (classified in {scene.seconds:.3f} s)"
-    else:
+    elif args.tolerance is not None:
+        if args.step is not None:
+            raise UsageError("--tolerance chooses the step itself: leave out --step")
+        if args.blend != "emission-absorption":
+            raise UsageError("--tolerance is kept for --blend emission-absorption only")
+        if args.method not in ("raycast", "auto"):
+            raise UsageError(f"--tolerance is kept by ray casting only: use --method raycast "
+                             f"or --method auto (not {args.method})")
         seconds, img = measure(partial(
             vrlib.render, volume, view, method=args.method, filter=_filter(args),
-            transfer=transfer, step=args.step, blend=args.blend), repeats=1, warmup=False)
+            transfer=transfer, tolerance=args.tolerance), repeats=1, warmup=False)
+        chosen = img.stats.choices
+        what = (f"{chosen['method']}/{_filter(args)} to rmse {args.tolerance:g} (step "
+                f"{chosen['step']:.3g} voxel, {chosen['classification']}, estimated error "
+                f"{chosen['estimate']:.2g})")
+    else:
+        step = 0.5 if args.step is None else args.step
+        seconds, img = measure(partial(
+            vrlib.render, volume, view, method=args.method, filter=_filter(args),
+            transfer=transfer, step=step, blend=args.blend), repeats=1, warmup=False)
         what = f"{args.method}/{_filter(args)}"
         if args.blend != "emission-absorption":
             what += f", {args.blend} intensity projection"
@@ -332,7 +348,8 @@ def cmd_turntable(args):
     transfer = make_transfer(args, field)(volume)
     images = vrlib.turntable(volume, args.output, frames=args.frames, elevation=args.elevation,
                              size=args.size, zoom=args.zoom, fps=args.fps, method=args.method,
-                             filter=_filter(args), transfer=transfer, step=args.step)
+                             filter=_filter(args), transfer=transfer,
+                             step=0.5 if args.step is None else args.step)
     seconds = sum(image.stats.seconds for image in images)
     print(f"{args.output}: {len(images)} frames of {args.size}x{args.size}, rendered in "
           f"{seconds:.2f} s")
@@ -519,7 +536,8 @@ def parser():
                             epilog=EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
     _add_scene(render)
     render.add_argument("--method", default="raycast",
-                        help="raycast, splat, shear3, shear2 or shearwarp (default raycast)")
+                        help="raycast, splat, shear3, shear2, shearwarp or auto (default "
+                             "raycast)")
     render.add_argument("--blend", default="emission-absorption",
                         choices=["emission-absorption", "maximum", "average"],
                         help="composite the samples (default), or project the largest "
@@ -527,6 +545,10 @@ def parser():
     render.add_argument("--classified", action="store_true",
                         help="classify once and render by shear-warp as VolPack does (takes "
                              "--shade; --method, --filter and --step do not apply)")
+    render.add_argument("--tolerance", type=float,
+                        help="render within this rmse (premultiplied RGBA, in (0, 1)) of the "
+                             "exact image of the field the filter reconstructs: the step is "
+                             "chosen for it (ray casting; no --step)")
     render.add_argument("--bits", type=int, default=8, choices=[8, 16], help="PNG bit depth")
     render.add_argument("-o", "--output", required=True, help="output .png or .npy")
     render.set_defaults(run=cmd_render)
@@ -534,7 +556,8 @@ def parser():
                           epilog=EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
     _add_scene(spin)
     spin.add_argument("--method", default="raycast",
-                      help="raycast, splat, shear3, shear2 or shearwarp (default raycast)")
+                      help="raycast, splat, shear3, shear2, shearwarp or auto (default "
+                           "raycast)")
     spin.add_argument("--frames", type=int, default=36, help="views around the turntable")
     spin.add_argument("--fps", type=float, default=12.0, help="frames per second")
     spin.add_argument("-o", "--output", required=True, help="output .gif or .mp4")

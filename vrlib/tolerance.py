@@ -74,7 +74,7 @@ def render_within(volume, view, *, filt, transfer, tolerance, empty_space_skippi
     >>> vol = data_gen.make_field("marschner-lobb").sample(17)
     >>> img = vrlib.render(vol, vrlib.View.orbit(size=32), tolerance=1e-3)
     >>> sorted(img.stats.choices)[:4]
-    ['classification', 'early_termination', 'estimate', 'method']
+    ['classification', 'early_termination', 'estimate', 'filter']
     >>> bool(img.stats.choices["estimate"] <= 1e-3)
     True
     """

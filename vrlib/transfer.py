@@ -328,7 +328,14 @@ class PreintegratedTable(NamedTuple):
     colour_inverse_step``) its colour over its opacity, unless ``grey``. ``step`` says the
     field jumps at the segment's middle (the box filter) instead of running linearly: the
     segment is then half a segment at each end's value, from ``density`` and ``emission``
-    (on the same grid) alone."""
+    (on the same grid) alone.
+
+    Examples
+    --------
+    >>> table = Glow(1.0).preintegrated_table(0.25, 0.0, 2.0)
+    >>> table.step, table.grey, table.mean_emission.shape     # grey: no colour table
+    (False, True, (2, 2, 3))
+    """
 
     start: float
     inverse_step: float

@@ -1,0 +1,87 @@
+"""Figures: the promise of ``tolerance=`` (error achieved against error asked, time against
+the fastest fixed setting) and pre-integration against point sampling on steep transfer
+functions."""
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+from chapters.common import figure_path, read_json, result_path, save_figure
+
+MARKERS = "osD^v<>ph"
+
+
+def promise_figure():
+    data = read_json(result_path(__file__, "promise.json"))
+    cases = [c for c in data["cases"] if "rmse" in c]
+    scenes = list(dict.fromkeys(c["scene"] for c in cases))
+    labels = {c["scene"]: c["label"] for c in cases}
+    fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.4))
+    for i, scene in enumerate(scenes):
+        for view, fill in (("orthographic", True), ("perspective", False)):
+            sel = [c for c in cases if c["scene"] == scene and c["view"] == view]
+            if not sel:
+                continue
+            jitter = 1.0 + 0.06 * (i - len(scenes) / 2)
+            kwargs = dict(marker=MARKERS[i % len(MARKERS)], color=f"C{i}", ls="none", ms=5,
+                          mfc=f"C{i}" if fill else "none")
+            left.loglog([c["tolerance"] * jitter for c in sel], [c["rmse"] for c in sel],
+                        label=labels[scene] if fill else None, **kwargs)
+            right.semilogx([c["tolerance"] * jitter for c in sel],
+                           [c["ratio"] if c["ratio"] is not None else np.nan for c in sel],
+                           **kwargs)
+    span = np.array([5e-5, 2e-2])
+    left.loglog(span, span, "k-", lw=1, label="error = tolerance")
+    left.set_xlabel("tolerance asked (rmse)")
+    left.set_ylabel("rmse achieved against the exact image")
+    left.set_title(f"Error achieved ({data['summary']['kept']} of "
+                   f"{data['summary']['cases']} kept; hollow: perspective)", fontsize=10)
+    left.legend(fontsize=7, loc="upper left")
+    right.axhline(1.5, color="k", lw=1, ls="--")
+    right.axhline(1.0, color="k", lw=0.5)
+    right.set_xlabel("tolerance asked (rmse)")
+    right.set_ylabel("time / fastest fixed setting that meets it")
+    right.set_title("Time, pilot included, against a grid search", fontsize=10)
+    for ax in (left, right):
+        ax.grid(True, which="both", alpha=0.3)
+    fig.tight_layout()
+    save_figure(fig, figure_path(__file__, "promise.png"))
+
+
+def preintegration_figure():
+    data = read_json(result_path(__file__, "preintegration.json"))
+    rows = data["rows"]
+    fig, axes = plt.subplots(2, 3, figsize=(11, 7), sharey=False)
+    axes = axes.ravel()
+    styles = {"point, lattice ends": "--o", "point, exact ends": ":s",
+              "pre-integrated": "-D"}
+    for ax, row in zip(axes, rows, strict=False):
+        for name, curve in row["curves"].items():
+            ax.loglog(curve["samples"], curve["rmse"], styles[name], ms=3, label=name)
+        ax.set_title(row["scene"], fontsize=9)
+        ax.set_xlabel("samples")
+        ax.set_ylabel("rmse")
+        ax.grid(True, which="both", alpha=0.3)
+    axes[0].legend(fontsize=7)
+    ax = axes[len(rows)]
+    for i, row in enumerate(rows):
+        ratios = [np.nan if r is None else r for r in row["sample_ratio"]]
+        ax.semilogx(data["steps"], ratios, "-" + MARKERS[i], ms=4, label=row["scene"])
+    ax.axhline(4.0, color="k", lw=1, ls="--")
+    ax.set_xlabel("step of point sampling (voxels)")
+    ax.set_ylabel("samples saved at its error")
+    ax.set_title("Point samples / pre-integrated samples", fontsize=9)
+    ax.legend(fontsize=6)
+    ax.grid(True, which="both", alpha=0.3)
+    for extra in axes[len(rows) + 1:]:
+        extra.set_visible(False)
+    fig.tight_layout()
+    save_figure(fig, figure_path(__file__, "preintegration.png"))
+
+
+def main():
+    promise_figure()
+    preintegration_figure()
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,105 @@
+"""The promise of ``render(..., tolerance=t)`` over a matrix of cases: analytic scenes
+(dense, sparse, steep, coloured, shaded, live at the faces) from two views, and the MNI152
+template, at tolerances 1e-2 to 1e-4. For each case: the error achieved against the exact
+image of the field the filter reconstructs (the real volume: against a pre-integrated ray
+cast at 1/32 voxel), the estimate the render reported, its time, and the time of the
+fastest fixed setting that meets the same tolerance (a grid search over the step, with point
+and pre-integrated classification, exact ends, no early termination). Writes
+``build/results/ch11_tolerance/promise.json``.
+"""
+
+import time
+from functools import partial
+
+import numpy as np
+
+import vrlib
+from chapters.ch11_tolerance._cases import TOLERANCES, VIEWS, analytic_scenes, real_scene
+from chapters.common import by_profile, progress, result_path, write_json
+from vrlib.tolerance import STEP_SHARE, TERM_SHARE
+
+SIZE = by_profile(96, 192)
+#: The fixed settings searched: steps 2 down to 1/64 voxel, a factor sqrt(2) apart.
+GRID_STEPS = [float(2.0 ** (0.5 * k)) for k in range(2, -13, -1)]
+CLASSIFICATIONS = ["point", "preintegrated"]
+REPEATS = 3
+
+
+def timed(render):
+    """The image and the best of :data:`REPEATS` wall times of ``render()`` (after one warm
+    call, so that no compilation is timed)."""
+    image = render()
+    best = np.inf
+    for _ in range(REPEATS):
+        start = time.perf_counter()
+        image = render()
+        best = min(best, time.perf_counter() - start)
+    return image, best
+
+
+def fixed_settings(volume, view, transfer, reference):
+    """Error and time of every fixed setting of the grid."""
+    rows = []
+    for classification in CLASSIFICATIONS:
+        for step in GRID_STEPS:
+            image, seconds = timed(partial(vrlib.render, volume, view, transfer=transfer,
+                                           step=step, early_termination=1.0,
+                                           segment_ends="exact",
+                                           classification=classification))
+            rows.append({"classification": classification, "step": step, "seconds": seconds,
+                         "rmse": vrlib.metrics.rmse(image, reference)})
+    return rows
+
+
+def main():
+    scenes = [(key, label, vol, tf, "exact") for key, label, vol, tf in analytic_scenes()]
+    key, label, head, bone = real_scene()
+    scenes.append((key, label, head, bone, "fine"))
+    cases = []
+    for key, label, volume, transfer, kind in progress(scenes, "scenes"):
+        views = VIEWS if kind == "exact" else {"orthographic": VIEWS["orthographic"]}
+        for view_name, orbit in views.items():
+            view = vrlib.View.orbit(size=SIZE, **orbit)
+            if kind == "exact":
+                reference = vrlib.render_reference(vrlib.ReconstructedField(volume), view,
+                                                   transfer=transfer, tol=1e-8)
+            else:
+                reference = vrlib.render(volume, view, transfer=transfer, step=1.0 / 32,
+                                         early_termination=1.0,
+                                         classification="preintegrated")
+            grid = fixed_settings(volume, view, transfer, reference)
+            for tolerance in TOLERANCES:
+                try:
+                    image, seconds = timed(partial(vrlib.render, volume, view,
+                                                   transfer=transfer, tolerance=tolerance))
+                except ValueError as refusal:
+                    cases.append({"scene": key, "label": label, "view": view_name,
+                                  "tolerance": tolerance, "refused": str(refusal)})
+                    continue
+                meeting = [row for row in grid if row["rmse"] <= tolerance]
+                fastest = min(meeting, key=lambda row: row["seconds"]) if meeting else None
+                choices = image.stats.choices
+                cases.append({
+                    "scene": key, "label": label, "view": view_name, "reference": kind,
+                    "tolerance": tolerance, "rmse": vrlib.metrics.rmse(image, reference),
+                    "estimate": choices["estimate"], "step": choices["step"],
+                    "pilot_steps": len(choices["pilot"]["steps"]), "seconds": seconds,
+                    "fastest_fixed": fastest,
+                    "ratio": seconds / fastest["seconds"] if fastest else None,
+                })
+    kept = [c for c in cases if "rmse" in c and c["rmse"] <= c["tolerance"]]
+    ratios = [c["ratio"] for c in cases if c.get("ratio") is not None]
+    write_json(result_path(__file__, "promise.json"), {
+        "cases": cases, "size": SIZE, "grid_steps": GRID_STEPS,
+        "shares": {"term": TERM_SHARE, "step": STEP_SHARE},
+        "summary": {"cases": len(cases), "kept": len(kept),
+                    "refused": sum("refused" in c for c in cases),
+                    "worst_error_over_tolerance": max(c["rmse"] / c["tolerance"]
+                                                      for c in cases if "rmse" in c),
+                    "ratio_median": float(np.median(ratios)) if ratios else None,
+                    "ratio_max": float(np.max(ratios)) if ratios else None,
+                    "timed": len(ratios), "within_1_5": sum(r <= 1.5 for r in ratios)}})
+
+
+if __name__ == "__main__":
+    main()
