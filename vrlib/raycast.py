@@ -215,7 +215,7 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
     samples : int
         Samples reconstructed.
     """
-    tables = transfer.segment_table(ds, *value_range)
+    tables = None if preintegrated else transfer.segment_table(ds, *value_range)
     shading = transfer.shading
     if shading is None:
         lighting = (False, 0.0, 0.0, 0.0, 1.0, np.zeros(3), True)
@@ -229,13 +229,6 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
     ramp = transfer.gradient_opacity
     by_gradient = (np.zeros(2), np.zeros(2), False) if ramp is None else (
         ramp.magnitudes, ramp.factors, True)
-    grey = shading is None and bool(np.all(tables[4] == 1.0))  # colour equals opacity
-    if preintegrated:
-        profile = "step" if filt.radius <= 0.5 else "linear"  # the box filter jumps
-        pre = transfer.preintegrated_table(ds, *value_range, profile=profile)
-    else:
-        pre = (0.0, 1.0, np.zeros(2), np.zeros(2), np.ones((2, 3)), False, True, 0.0, 1.0,
-               np.ones((2, 2, 3)))
     out = np.empty(view.shape + (4,))
     rows, cols = -(-view.height // TILE[0]), -(-view.width // TILE[1])
     samples = np.zeros(rows * cols, dtype=np.int64)
@@ -245,17 +238,23 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
     padded = np.zeros((rows * TILE[0], cols * TILE[1]))
     padded[: view.height, : view.width] = mask + 0.05
     costs = padded.reshape(rows, TILE[0], cols, TILE[1]).sum(axis=(1, 3)).ravel()
-    _kernel.raycast(
-        data, np.asarray(offset, np.int64), np.asarray(global_shape, np.int64),
-        np.asarray(origin, np.float64), np.asarray(spacing, np.float64),
-        np.asarray(box[0], np.float64), np.asarray(box[1], np.float64),
-        *lattice_extent(global_shape, spacing, origin).T.copy(), bool(exact_ends), view.packed(),
-        view.height, view.width,
-        ds, *filt.code, filt.radius, filt.taps, *tables, *lighting, *by_gradient,
-        early_termination, *skip,
-        np.zeros((1, 1, 1)) if bound is None else bound, float(budget),
-        *TILE, balanced_order(costs, numba.get_num_threads()), out, samples, grey,
-        bool(preintegrated), *pre,
-    )
+    layout = (data, np.asarray(offset, np.int64), np.asarray(global_shape, np.int64),
+              np.asarray(origin, np.float64), np.asarray(spacing, np.float64),
+              np.asarray(box[0], np.float64), np.asarray(box[1], np.float64),
+              *lattice_extent(global_shape, spacing, origin).T.copy())
+    skips = (early_termination, *skip, np.zeros((1, 1, 1)) if bound is None else bound,
+             float(budget), *TILE, balanced_order(costs, numba.get_num_threads()), out, samples)
+    if preintegrated:
+        profile = "step" if filt.radius <= 0.5 else "linear"  # the box filter jumps
+        _kernel.raycast_preintegrated(
+            *layout, view.packed(), view.height, view.width, ds, *filt.code, filt.radius,
+            filt.taps, *transfer.preintegrated_table(ds, *value_range, profile=profile),
+            *lighting, *by_gradient, *skips)
+    else:
+        grey = shading is None and bool(np.all(tables[4] == 1.0))  # colour equals opacity
+        _kernel.raycast(
+            *layout, bool(exact_ends), view.packed(), view.height, view.width, ds,
+            *filt.code, filt.radius, filt.taps, *tables, *lighting, *by_gradient, *skips,
+            grey)
     np.clip(out[..., 3], 0.0, 1.0, out=out[..., 3])
     return out, int(samples.sum())

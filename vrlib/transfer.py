@@ -15,6 +15,7 @@ The rendering model (eqs 1.2-1.5) needs, at every point, a differential opacity
 from __future__ import annotations
 
 import weakref
+from collections import OrderedDict
 from typing import NamedTuple
 
 import numpy as np
@@ -261,13 +262,17 @@ class TransferFunction:
         low, high = float(low), float(high)
         if not high > low:
             high = low + 1.0  # one value: any span will do
-        # The last table is kept (a turntable renders many frames with one step and range).
+        # The last few tables are kept with the transfer function: a turntable renders many
+        # frames with one step, and a render to a tolerance tries a few steps each time.
         key = (length, low, high, entries, refine, profile)
-        owner, last_key, table = _LAST_TABLE[0]
-        if owner() is not self or last_key != key:
-            table = self._preintegrate(length, low, high, entries, refine, profile)
-            _LAST_TABLE[0] = (weakref.ref(self), key, table)
-        return table
+        kept = _TABLES.setdefault(self, OrderedDict())
+        if key in kept:
+            kept.move_to_end(key)
+        else:
+            kept[key] = self._preintegrate(length, low, high, entries, refine, profile)
+            while len(kept) > _TABLES_KEPT:
+                kept.popitem(last=False)
+        return kept[key]
 
     def _preintegrate(self, length, low, high, entries, refine, profile):
         from vrlib._kernels.preintegration import cumulative_at, mean_emission_table
@@ -316,7 +321,8 @@ class TransferFunction:
         return start, inverse_step, self.opacity_density(values), self.emission(values)
 
 
-_LAST_TABLE = [(lambda: None, None, None)]  # (weak reference to its transfer, key, table)
+_TABLES = weakref.WeakKeyDictionary()  # pre-integrated tables kept per transfer function
+_TABLES_KEPT = 8
 
 
 class PreintegratedTable(NamedTuple):

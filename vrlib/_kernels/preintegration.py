@@ -12,8 +12,10 @@ of its value grid (kinks on nodes, :meth:`vrlib.TransferFunction.value_table`), 
 ``Phi(v) = int^v E Omega`` are exact piecewise polynomials there.
 
 * The opacity needs ``Psi`` alone: kernels evaluate it exactly from the value grid's density
-  and its running integral (:func:`mean_density`), so the opacity is exact however steep the
-  transfer function and whatever the two values.
+  and its running integral (:func:`psi_at`), and take the mean density
+  ``(Psi(b) - Psi(a)) / (b - a)`` (the density at the middle where ``a`` and ``b`` are too
+  close for the difference), so the opacity is exact however steep the transfer function
+  and whatever the two values.
 * The colour needs a table over (front, back): :func:`mean_emission_table` stores the
   segment's colour over its opacity, the emission averaged with the weights the segment's
   light has. It evaluates ``Psi`` and ``Phi`` exactly at ``refine`` points per table cell;
@@ -29,7 +31,7 @@ import numpy as np
 from numba import prange
 
 from vrlib._kernels._jit import jit, parallel_jit
-from vrlib._kernels.tables import interpolate, lookup
+from vrlib._kernels.tables import lookup
 
 
 @jit
@@ -119,16 +121,6 @@ def psi_at(v, start, inv, density, psi):
     i = int(x)
     f = x - i
     return psi[i] + (density[i] * f + 0.5 * (density[i + 1] - density[i]) * f * f) / inv
-
-
-@jit(inline="always")
-def mean_density(a, b, start, inv, density, psi):
-    """The mean opacity density ``(Psi(b) - Psi(a)) / (b - a)`` over a segment whose field
-    runs linearly from ``a`` to ``b``; the density at the middle where the two values are
-    too close for the difference to be accurate."""
-    if abs(b - a) * inv < 1e-6:
-        return interpolate(density, start, inv, 0.5 * (a + b))
-    return (psi_at(b, start, inv, density, psi) - psi_at(a, start, inv, density, psi)) / (b - a)
 
 
 @jit(inline="always")

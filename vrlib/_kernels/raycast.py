@@ -24,12 +24,12 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import prange
+from numba import literally, prange
 
 from vrlib._kernels._jit import jit, parallel_jit
 from vrlib._kernels.camera import pixel_ray, ray_box
 from vrlib._kernels.filters import CUBIC, TENT
-from vrlib._kernels.preintegration import bilinear_channel, mean_density
+from vrlib._kernels.preintegration import bilinear_channel, psi_at
 from vrlib._kernels.sampling import (
     gradient,
     reconstruct,
@@ -95,56 +95,330 @@ def _part_of_segment(alpha, fraction):
 
 
 @jit
-def _sample(data, flat, nx, nxy, offset, gshape, ux, uy, uz, fkind, fp0, fp1, fp2, radius,
-            ntaps, wx, wy, wz):
-    """The reconstructed value at global index position ``(ux, uy, uz)``, as the point
-    sampling loop computes it inline, as a call: the pre-integrated path's reconstructions
-    then leave that loop as small (and fast) as it was."""
-    if fkind == TENT:
-        return trilinear(flat, nx, nxy, offset[0], offset[1], offset[2], gshape[0], gshape[1],
-                         gshape[2], ux, uy, uz)
+def _other_value(data, flat, nx, nxy, oz, oy, ox, gz, gy, gx, offset, gshape, ux, uy, uz,
+                 fkind, fp0, fp1, fp2, radius, ntaps, wx, wy, wz):
+    """The value at global index position ``(ux, uy, uz)`` for every filter but the tent,
+    as the point-sampling loop computes it: the piecewise cubics and 4-tap filters unrolled,
+    the others through the general loop. The layout comes as scalars (``nx``, ``nxy``, the
+    offset ``oz, oy, ox`` and the global shape ``gz, gy, gx``); a call, not inlined, so that
+    the loops around it stay small."""
     if fkind == CUBIC:
-        return tricubic(flat, nx, nxy, offset[0], offset[1], offset[2], gshape[0], gshape[1],
-                        gshape[2], ux, uy, uz, fp0, fp1, fp2)
+        return tricubic(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz, fp0, fp1, fp2)
     if ntaps == 4:
-        return separable4(flat, nx, nxy, offset[0], offset[1], offset[2], gshape[0],
-                          gshape[1], gshape[2], ux, uy, uz, fkind, fp0, fp1, fp2, radius)
+        return separable4(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz, fkind, fp0, fp1,
+                          fp2, radius)
     return reconstruct(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1, fp2, radius, ntaps,
                        wx, wy, wz)
 
 
+@jit(inline="always")
+def _skip(k, ux, uy, uz, ax, ay, az, bx, by, bz, ds, by_front, empty, coarse, block,
+          fine_counts, coarse_counts, bound, budget, spent, k_first, k_last, t_first, t_last):
+    """Skipping at segment ``k``, whose check point (its sample, or its front end when
+    ``by_front``: a pre-integrated segment) lies at index position ``u``: returns
+    ``(k_next, t_check, spent)``. ``k_next > k`` skips to segment ``k_next``; otherwise
+    the segment is taken, and so are those before ``t_check`` (their block is not empty).
+
+    An empty block is jumped over (the largest empty block here: the coarse one if it is
+    empty), then any segment that rounding placed in a block that is not empty is stepped
+    back over: the image is unchanged. By its front end, only the segments that also end
+    inside the empty block are jumped, so that the whole run lies in one empty box. A block
+    that is not empty is left out while the bounds of what the ray has left out stay within
+    ``budget`` (``spent`` so far)."""
+    if not _is_empty(empty, block, ux, uy, uz):
+        t_exit = _exit(ax, ay, az, bx, by, bz, block, fine_counts, ux, uy, uz)
+        if budget > 0.0:
+            cost = _block_bound(bound, block, ux, uy, uz)
+            if spent + cost <= budget:
+                # Skipping by the error budget: leave out what this block could add.
+                if by_front:
+                    return max(math.ceil(t_exit / ds), k + 1), -math.inf, spent + cost
+                return max(math.ceil(t_exit / ds - 0.5), k + 1), -math.inf, spent + cost
+        return k, t_exit, spent
+    if _is_empty(coarse, 4 * block, ux, uy, uz):
+        t_exit = _exit(ax, ay, az, bx, by, bz, 4 * block, coarse_counts, ux, uy, uz)
+    else:
+        t_exit = _exit(ax, ay, az, bx, by, bz, block, fine_counts, ux, uy, uz)
+    if by_front:
+        k_next = math.floor(t_exit / ds)
+        while k_next > k:
+            tb = k_next * ds
+            if _is_empty(empty, block, ax + tb * bx, ay + tb * by, az + tb * bz):
+                break
+            k_next -= 1
+        return k_next, -math.inf, spent
+    k_next = max(math.ceil(t_exit / ds - 0.5), k + 1)
+    while k_next > k + 1:
+        tb = (k_next - 0.5) * ds
+        if k_next - 1 == k_first or k_next - 1 == k_last:
+            tb = _cut_segment(k_next - 1, ds, t_first, t_last)[0]
+        if _is_empty(empty, block, ax + tb * bx, ay + tb * by, az + tb * bz):
+            break
+        k_next -= 1
+    return k_next, -math.inf, spent
+
+
 @jit
-def _preintegrated(front, back, length, start, inv, density, psi, emission, step, grey,
-                   col_start, col_inv, mean):
-    """Opacity and premultiplied colour ``(alpha, r, g, b)`` of a segment of ``length`` from
-    its front and back values (:class:`vrlib.transfer.PreintegratedTable`)."""
-    if step:
-        # A step at the middle (the box filter): half a segment at the front value over
-        # half at the back value, exactly.
-        half_a = -math.expm1(-0.5 * length * interpolate(density, start, inv, front))
-        half_b = -math.expm1(-0.5 * length * interpolate(density, start, inv, back))
-        alpha = 1.0 - (1.0 - half_a) * (1.0 - half_b)
-        if grey or not alpha > 0.0:
-            return alpha, alpha, alpha, alpha
-        behind = (1.0 - half_a) * half_b
-        return (alpha,
-                half_a * interpolate_channel(emission, start, inv, front, 0)
-                + behind * interpolate_channel(emission, start, inv, back, 0),
-                half_a * interpolate_channel(emission, start, inv, front, 1)
-                + behind * interpolate_channel(emission, start, inv, back, 1),
-                half_a * interpolate_channel(emission, start, inv, front, 2)
-                + behind * interpolate_channel(emission, start, inv, back, 2))
-    # A linear ramp: the opacity exact from the density's running integral, the colour from
-    # the (front, back) table of the segment's mean emission.
-    alpha = -math.expm1(-length * mean_density(front, back, start, inv, density, psi))
+def _preintegrated_ray(tent, data, flat, offset, gshape, inv, d, ax, ay, az, bx, by, bz, t_in,
+                       t_out, k, ds, k_first, k_last, t_first, t_last, fkind, fp0, fp1, fp2,
+                       radius, ntaps, start, vinv, density, psi, emission, step, grey,
+                       col_start, col_inv, mean, shade, ka, kd, ks, shininess, light,
+                       headlight, ramp_x, ramp_y, by_gradient, threshold, empty, coarse, block,
+                       fine_counts, coarse_counts, bound, budget):
+    """One ray, pre-integrated: each segment ``[k ds, (k + 1) ds)`` (cut at the volume's
+    faces) classified from its values at its two ends (the back of one is the front of the
+    next), front to back from segment ``k`` while its middle lies before ``t_out``. Returns
+    ``(r, g, b, a, samples)``. ``tent`` (a compile-time constant: the loop is compiled once
+    for the tent filter, with no call in it, and once for the others, which call
+    :func:`_other_value`; a call in the loop, even one not taken, made the tent filter's
+    loop three times slower) says the filter is the tent; the other arguments are
+    :func:`raycast`'s (the table's named without ``pre_``)."""
+    literally(tent)
+    wx, wy, wz, dx, dy, dz = tap_scratch()
+    nx = data.shape[2]
+    nxy = data.shape[1] * data.shape[2]
+    oz, oy, ox = offset[0], offset[1], offset[2]
+    gz, gy, gx = gshape[0], gshape[1], gshape[2]
+    acc_r = 0.0
+    acc_g = 0.0
+    acc_b = 0.0
+    acc_a = 0.0
+    taken = 0
+    spent = 0.0
+    t_check = -math.inf if block > 0 else math.inf
+    k_front = -1  # the segment whose front value (and its Psi) `front` holds
+    front = 0.0
+    psi_front = 0.0
+    while True:
+        t = (k + 0.5) * ds
+        cut = k == k_first or k == k_last
+        if cut:
+            t = _cut_segment(k, ds, t_first, t_last)[0]
+            if t < t_in:  # another brick's segment
+                k += 1
+                continue
+        if t >= t_out:
+            break
+        t_a = k * ds
+        t_b = t_a + ds
+        if cut:
+            t_a = max(t_a, t_first)
+            t_b = min(t_b, t_last)
+        if t_a >= t_check:
+            k_next, t_check, spent = _skip(
+                k, ax + t_a * bx, ay + t_a * by, az + t_a * bz, ax, ay, az, bx, by, bz, ds,
+                True, empty, coarse, block, fine_counts, coarse_counts, bound, budget, spent,
+                k_first, k_last, t_first, t_last)
+            if k_next > k:
+                k = k_next
+                continue
+        if k != k_front:
+            if tent:
+                front = trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ax + t_a * bx,
+                                  ay + t_a * by, az + t_a * bz)
+            else:
+                front = _other_value(data, flat, nx, nxy, oz, oy, ox, gz, gy, gx, offset,
+                                     gshape, ax + t_a * bx, ay + t_a * by, az + t_a * bz,
+                                     fkind, fp0, fp1, fp2, radius, ntaps, wx, wy, wz)
+            psi_front = psi_at(front, start, vinv, density, psi)
+            taken += 1
+        if tent:
+            back = trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ax + t_b * bx,
+                             ay + t_b * by, az + t_b * bz)
+        else:
+            back = _other_value(data, flat, nx, nxy, oz, oy, ox, gz, gy, gx, offset, gshape,
+                                ax + t_b * bx, ay + t_b * by, az + t_b * bz, fkind, fp0, fp1,
+                                fp2, radius, ntaps, wx, wy, wz)
+        psi_back = psi_at(back, start, vinv, density, psi)
+        taken += 1
+        # A cut segment's own length: its opacity is exact, its colour's mean emission that
+        # of a whole segment.
+        length = t_b - t_a if cut else ds
+        if step:
+            alpha, cr, cg, cb = _step_segment(front, back, length, start, vinv, density,
+                                              emission, grey)
+        else:
+            # A linear ramp: the opacity exact from the density's running integral (eq 1.4
+            # with the mean density), the colour from the table of the mean emission.
+            if abs(back - front) * vinv < 1e-6:
+                mean_density = interpolate(density, start, vinv, 0.5 * (front + back))
+            else:
+                mean_density = (psi_back - psi_front) / (back - front)
+            alpha = -math.expm1(-length * mean_density)
+            cr = cg = cb = alpha
+            if alpha > 0.0 and not grey:
+                px = (front - col_start) * col_inv
+                py = (back - col_start) * col_inv
+                n = mean.shape[0]
+                cr = alpha * bilinear_channel(mean, px, py, n, 0)
+                cg = alpha * bilinear_channel(mean, px, py, n, 1)
+                cb = alpha * bilinear_channel(mean, px, py, n, 2)
+        front = back
+        psi_front = psi_back
+        k += 1
+        k_front = k
+        if not alpha > 0.0:
+            continue
+        if shade or by_gradient:
+            # The gradient at the segment's middle modulates the segment.
+            ux, uy, uz = ax + t * bx, ay + t * by, az + t * bz
+            gx_, gy_, gz_ = gradient(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1, fp2,
+                                     radius, ntaps, wx, wy, wz, dx, dy, dz)
+            if headlight:
+                lx, ly, lz = -d[0], -d[1], -d[2]
+            else:
+                lx, ly, lz = light[0], light[1], light[2]
+            alpha, cr, cg, cb = modulate_by_gradient(
+                alpha, cr, cg, cb, gx_ * inv[0], gy_ * inv[1], gz_ * inv[2], by_gradient,
+                ramp_x, ramp_y, shade, lx, ly, lz, d[0], d[1], d[2], ka, kd, ks, shininess)
+            if not alpha > 0.0:
+                continue
+        # Front-to-back over, eqs 1.7-1.8.
+        remaining = 1.0 - acc_a
+        acc_r += remaining * cr
+        acc_g += remaining * cg
+        acc_b += remaining * cb
+        acc_a += remaining * alpha
+        if acc_a >= threshold:
+            break
+    return acc_r, acc_g, acc_b, acc_a, taken
+
+
+@jit
+def _step_segment(front, back, length, start, inv, density, emission, grey):
+    """A pre-integrated segment of ``length`` across a step at its middle (the box filter):
+    half a segment at the front value over half at the back value, exactly. Returns
+    ``(alpha, r, g, b)``."""
+    half_a = -math.expm1(-0.5 * length * interpolate(density, start, inv, front))
+    half_b = -math.expm1(-0.5 * length * interpolate(density, start, inv, back))
+    alpha = 1.0 - (1.0 - half_a) * (1.0 - half_b)
     if grey or not alpha > 0.0:
         return alpha, alpha, alpha, alpha
-    px = (front - col_start) * col_inv
-    py = (back - col_start) * col_inv
-    n = mean.shape[0]
-    return (alpha, alpha * bilinear_channel(mean, px, py, n, 0),
-            alpha * bilinear_channel(mean, px, py, n, 1),
-            alpha * bilinear_channel(mean, px, py, n, 2))
+    behind = (1.0 - half_a) * half_b
+    return (alpha,
+            half_a * interpolate_channel(emission, start, inv, front, 0)
+            + behind * interpolate_channel(emission, start, inv, back, 0),
+            half_a * interpolate_channel(emission, start, inv, front, 1)
+            + behind * interpolate_channel(emission, start, inv, back, 1),
+            half_a * interpolate_channel(emission, start, inv, front, 2)
+            + behind * interpolate_channel(emission, start, inv, back, 2))
+
+
+@jit(inline="always")
+def _ray_start(o, d, box_lo, box_hi, vol_lo, vol_hi, exact, origin, inv, ds):
+    """Where ray ``o + t d`` takes samples: ``(t_in, t_out)`` in the box ``[box_lo,
+    box_hi]`` (none when ``t_out <= t_in``), its index position ``a + t b``, the first
+    segment ``k``, and with ``exact`` the segments ``k_first`` and ``k_last`` that the
+    volume's faces cut at ``t_first`` and ``t_last`` (-1 without; a cut segment's sample may
+    lie before segment ``k``'s, so ``k`` starts there)."""
+    t_in, t_out = ray_box(o, d, box_lo, box_hi)
+    t_in = max(t_in, 0.0)
+    # Index position of sample k: a + t b, the same for every brick of a volume.
+    ax = (o[0] - origin[0]) * inv[0]
+    ay = (o[1] - origin[1]) * inv[1]
+    az = (o[2] - origin[2]) * inv[2]
+    bx = d[0] * inv[0]
+    by = d[1] * inv[1]
+    bz = d[2] * inv[2]
+    k = math.ceil(t_in / ds - 0.5)
+    k_first = k_last = -1
+    t_first = t_last = 0.0
+    if exact:
+        t_first, t_last = ray_box(o, d, vol_lo, vol_hi)
+        t_first = max(t_first, 0.0)
+        k_first = math.floor(t_first / ds)
+        k_last = math.ceil(t_last / ds) - 1
+        if k - 1 == k_first or k - 1 == k_last:
+            k -= 1
+    return t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, t_first, t_last
+
+
+@parallel_jit
+def raycast_preintegrated(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo,
+                          vol_hi, camera, height, width, ds, fkind, fp0, fp1, fp2, radius,
+                          ntaps, pre_start, pre_inv, pre_density, pre_psi, pre_emission,
+                          pre_step, pre_grey, col_start, col_inv, pre_mean, shade, ka, kd, ks,
+                          shininess, light, headlight, ramp_x, ramp_y, by_gradient, threshold,
+                          empty, coarse, block, mask, bound, budget, tile_h, tile_w, order,
+                          out, samples):
+    """:func:`raycast` with pre-integrated classification (a kernel of its own, so that a
+    render compiles only the loop it runs): each segment is classified from its values at
+    its two ends (:func:`_preintegrated_ray`), always cut at the volume's faces. The
+    opacity comes from the mean density (``pre_density`` and its running integral
+    ``pre_psi`` on the grid ``(value - pre_start) * pre_inv``), the colour as the opacity
+    times the mean emission ``pre_mean[front, back]`` (grid ``(value - col_start) *
+    col_inv``) unless ``pre_grey``; with ``pre_step`` (the box filter) half a segment at
+    each end's value, ``pre_emission`` on the density's grid
+    (:class:`vrlib.transfer.PreintegratedTable`). The other arguments are as for
+    :func:`raycast`."""
+    flat = data.reshape(-1)
+    inv = 1.0 / spacing
+    fine_counts = np.array(empty.shape)
+    coarse_counts = np.array(coarse.shape)
+    for it in prange(order.shape[0]):
+        tile_id = order[it]
+        samples[tile_id] = _tile_preintegrated(
+            tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, origin,
+            box_lo, box_hi, vol_lo, vol_hi, camera, height, width, ds, fkind, fp0, fp1, fp2,
+            radius, ntaps, pre_start, pre_inv, pre_density, pre_psi, pre_emission, pre_step,
+            pre_grey, col_start, col_inv, pre_mean, shade, ka, kd, ks, shininess, light,
+            headlight, ramp_x, ramp_y, by_gradient, threshold, empty, coarse, block, mask,
+            bound, budget, tile_h, tile_w, out)
+
+
+@jit
+def _tile_preintegrated(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape,
+                        origin, box_lo, box_hi, vol_lo, vol_hi, camera, height, width, ds,
+                        fkind, fp0, fp1, fp2, radius, ntaps, pre_start, pre_inv, pre_density,
+                        pre_psi, pre_emission, pre_step, pre_grey, col_start, col_inv,
+                        pre_mean, shade, ka, kd, ks, shininess, light, headlight, ramp_x,
+                        ramp_y, by_gradient, threshold, empty, coarse, block, mask, bound,
+                        budget, tile_h, tile_w, out):
+    """Tile ``tile_id`` of :func:`raycast_preintegrated` (the same arguments, as
+    :func:`_tile`'s): its pixels' rays, front to back; returns the samples taken."""
+    tiles_across = (width + tile_w - 1) // tile_w
+    row0 = (tile_id // tiles_across) * tile_h
+    col0 = (tile_id % tiles_across) * tile_w
+    taken = 0
+    for p in range(tile_h * tile_w):
+        r = row0 + p // tile_w
+        c = col0 + p % tile_w
+        if r >= height or c >= width:
+            continue
+        o, d = pixel_ray(camera, height, width, r, c)
+        out[r, c, 0] = 0.0
+        out[r, c, 1] = 0.0
+        out[r, c, 2] = 0.0
+        out[r, c, 3] = 0.0
+        if not mask[r, c]:
+            continue
+        t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, t_first, t_last = _ray_start(
+            o, d, box_lo, box_hi, vol_lo, vol_hi, True, origin, inv, ds)
+        if not t_out > t_in:
+            continue
+        # One compiled loop per reconstruction: the tent filter's holds no call.
+        if fkind == TENT:
+            rgba = _preintegrated_ray(
+                True, data, flat, offset, gshape, inv, d, ax, ay, az, bx, by, bz, t_in, t_out,
+                k, ds, k_first, k_last, t_first, t_last, fkind, fp0, fp1, fp2, radius, ntaps,
+                pre_start, pre_inv, pre_density, pre_psi, pre_emission, pre_step, pre_grey,
+                col_start, col_inv, pre_mean, shade, ka, kd, ks, shininess, light, headlight,
+                ramp_x, ramp_y, by_gradient, threshold, empty, coarse, block, fine_counts,
+                coarse_counts, bound, budget)
+        else:
+            rgba = _preintegrated_ray(
+                False, data, flat, offset, gshape, inv, d, ax, ay, az, bx, by, bz, t_in, t_out,
+                k, ds, k_first, k_last, t_first, t_last, fkind, fp0, fp1, fp2, radius, ntaps,
+                pre_start, pre_inv, pre_density, pre_psi, pre_emission, pre_step, pre_grey,
+                col_start, col_inv, pre_mean, shade, ka, kd, ks, shininess, light, headlight,
+                ramp_x, ramp_y, by_gradient, threshold, empty, coarse, block, fine_counts,
+                coarse_counts, bound, budget)
+        out[r, c, 0] = rgba[0]
+        out[r, c, 1] = rgba[1]
+        out[r, c, 2] = rgba[2]
+        out[r, c, 3] = rgba[3]
+        taken += rgba[4]
+    return taken
 
 
 @parallel_jit
@@ -154,9 +428,7 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
             tstart, tinv, alpha_tab, color_tab, emit_tab,
             shade, ka, kd, ks, shininess, light, headlight, ramp_x, ramp_y, by_gradient,
             threshold, empty, coarse, block, mask, bound, budget, tile_h, tile_w, order, out,
-            samples, grey,
-            preint, pre_start, pre_inv, pre_density, pre_psi, pre_emission, pre_step, pre_grey,
-            col_start, col_inv, pre_mean):
+            samples, grey):
     """Render ``out[row, col] = (r, g, b, a)`` premultiplied; count samples per tile.
 
     ``data`` holds the samples from global index ``offset`` on (the whole volume, or a brick
@@ -177,13 +449,6 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
     most a ray can change any channel by leaving the block out) of the blocks it skipped add
     up to at most ``budget``: each pixel changes by at most ``budget``.
     ``grey`` says the emission is 1 everywhere and unshaded, so colour equals opacity.
-    ``preint`` classifies each segment from its values at its two ends instead of its
-    middle's value: the opacity from the mean density (``pre_density`` and its running
-    integral ``pre_psi`` on the grid ``(value - pre_start) * pre_inv``), the colour as the
-    opacity times the mean emission ``pre_mean[front, back]`` (grid ``(value - col_start) *
-    col_inv``) unless ``pre_grey``; with ``pre_step`` (the box filter) half a segment at each
-    end's value, with ``pre_emission`` on the same grid as the density
-    (:class:`vrlib.transfer.PreintegratedTable`).
     ``by_gradient`` multiplies the density by the piecewise-linear factor through
     ``(ramp_x, ramp_y)`` of the gradient magnitude (per world unit).
     """
@@ -201,9 +466,7 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
             ds, fkind, fp0, fp1, fp2, radius, ntaps, tstart, tinv, alpha_tab, color_tab,
             emit_tab, shade, ka, kd, ks, shininess, light, headlight, ramp_x, ramp_y,
             by_gradient, threshold, empty, coarse, block, mask, bound, budget, tile_h, tile_w,
-            out, grey,
-            preint, pre_start, pre_inv, pre_density, pre_psi, pre_emission, pre_step, pre_grey,
-            col_start, col_inv, pre_mean)
+            out, grey)
 
 
 @jit
@@ -211,9 +474,7 @@ def _tile(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, 
           box_lo, box_hi, vol_lo, vol_hi, exact, camera, height, width, ds, fkind, fp0, fp1, fp2,
           radius, ntaps, tstart, tinv, alpha_tab, color_tab, emit_tab, shade, ka, kd, ks,
           shininess, light, headlight, ramp_x, ramp_y, by_gradient, threshold, empty, coarse,
-          block, mask, bound, budget, tile_h, tile_w, out, grey, preint, pre_start, pre_inv,
-          pre_density, pre_psi, pre_emission, pre_step, pre_grey, col_start, col_inv,
-          pre_mean):
+          block, mask, bound, budget, tile_h, tile_w, out, grey):
     """Tile ``tile_id`` of :func:`raycast` (the same arguments): its pixels' rays, front to
     back, in a fixed order; returns the samples taken. ``flat`` is ``data`` raveled, ``inv``
     the inverse spacing, ``fine_counts`` and ``coarse_counts`` the skip grids' shapes."""
@@ -223,8 +484,7 @@ def _tile(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, 
     oz, oy, ox = offset[0], offset[1], offset[2]
     gz, gy, gx = gshape[0], gshape[1], gshape[2]
     ntab = alpha_tab.shape[0]
-    plain = (fkind == TENT and grey and not shade and not by_gradient and block == 0
-             and not preint)
+    plain = fkind == TENT and grey and not shade and not by_gradient and block == 0
     row0 = (tile_id // tiles_across) * tile_h
     col0 = (tile_id % tiles_across) * tile_w
     wx, wy, wz, dx, dy, dz = tap_scratch()
@@ -241,36 +501,15 @@ def _tile(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, 
         out[r, c, 3] = 0.0
         if not mask[r, c]:
             continue
-        t_in, t_out = ray_box(o, d, box_lo, box_hi)
-        t_in = max(t_in, 0.0)
+        t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, t_first, t_last = _ray_start(
+            o, d, box_lo, box_hi, vol_lo, vol_hi, exact, origin, inv, ds)
         if not t_out > t_in:
             continue
         acc_r = 0.0
         acc_g = 0.0
         acc_b = 0.0
         acc_a = 0.0
-        # Index position of sample k: a + t b, the same for every brick of a volume.
-        ax = (o[0] - origin[0]) * inv[0]
-        ay = (o[1] - origin[1]) * inv[1]
-        az = (o[2] - origin[2]) * inv[2]
-        bx = d[0] * inv[0]
-        by = d[1] * inv[1]
-        bz = d[2] * inv[2]
-        k = math.ceil(t_in / ds - 0.5)
-        # Exact ends: the segments k_first and k_last that the volume's faces cut; -1 (no
-        # segment) without. A cut segment's sample may lie before sample k.
-        k_first = k_last = -1
-        t_first = t_last = 0.0
-        if exact:
-            t_first, t_last = ray_box(o, d, vol_lo, vol_hi)
-            t_first = max(t_first, 0.0)
-            k_first = math.floor(t_first / ds)
-            k_last = math.ceil(t_last / ds) - 1
-            if k - 1 == k_first or k - 1 == k_last:
-                k -= 1
         spent = 0.0  # the budget's share this ray has used
-        k_front = -1  # the segment whose front value `front` holds (pre-integration)
-        front = 0.0
         if plain:
             # The common case, its loop stripped: tent filter, white unshaded emission,
             # nothing to skip. The same arithmetic as the general loop below.
@@ -318,146 +557,54 @@ def _tile(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, 
                 ux = ax + t * bx
                 uy = ay + t * by
                 uz = az + t * bz
-                # A sample is skipped by its position; a pre-integrated segment, which
-                # reaches from one end to the other, by its front end.
-                t_a = k * ds
-                if fraction != 1.0:
-                    t_a = max(t_a, t_first)
-                tc = t_a if preint else t
-                cx = ax + tc * bx
-                cy = ay + tc * by
-                cz = az + tc * bz
-                if tc >= t_check and not _is_empty(empty, block, cx, cy, cz):
-                    t_exit = _exit(ax, ay, az, bx, by, bz, block, fine_counts, cx, cy, cz)
-                    cost = _block_bound(bound, block, cx, cy, cz) if budget > 0.0 else 0.0
-                    if budget > 0.0 and spent + cost <= budget:
-                        # Skipping by the error budget: leave out what this block could add.
-                        spent += cost
-                        if preint:
-                            k = max(math.ceil(t_exit / ds), k + 1)
-                        else:
-                            k = max(math.ceil(t_exit / ds - 0.5), k + 1)
-                        continue
-                    t_check = t_exit
-                elif tc >= t_check:
-                    # Jump past the largest empty block here, then step back over any
-                    # sample that rounding placed in a block that is not empty: the image
-                    # is unchanged.
-                    if _is_empty(coarse, 4 * block, cx, cy, cz):
-                        t_exit = _exit(ax, ay, az, bx, by, bz, 4 * block, coarse_counts,
-                                       cx, cy, cz)
-                    else:
-                        t_exit = _exit(ax, ay, az, bx, by, bz, block, fine_counts, cx, cy, cz)
-                    if preint:
-                        # Skip the segments that end inside the block too: both ends of
-                        # the run lie in one empty box, so all of it does.
-                        k_next = math.floor(t_exit / ds)
-                        while k_next > k:
-                            tb = k_next * ds
-                            if _is_empty(empty, block, ax + tb * bx, ay + tb * by,
-                                         az + tb * bz):
-                                break
-                            k_next -= 1
-                        if k_next > k:
-                            k = k_next
-                            continue
-                    else:
-                        k_next = max(math.ceil(t_exit / ds - 0.5), k + 1)
-                        while k_next > k + 1:
-                            tb = (k_next - 0.5) * ds
-                            if k_next - 1 == k_first or k_next - 1 == k_last:
-                                tb = _cut_segment(k_next - 1, ds, t_first, t_last)[0]
-                            if _is_empty(empty, block, ax + tb * bx, ay + tb * by,
-                                         az + tb * bz):
-                                break
-                            k_next -= 1
+                if t >= t_check:
+                    k_next, t_check, spent = _skip(
+                        k, ux, uy, uz, ax, ay, az, bx, by, bz, ds, False, empty, coarse,
+                        block, fine_counts, coarse_counts, bound, budget, spent, k_first,
+                        k_last, t_first, t_last)
+                    if k_next > k:
                         k = k_next
                         continue
-                if preint:
-                    # Pre-integrated: the segment's values at its two ends (the back of one
-                    # segment is the front of the next).
-                    t_b = (k + 1) * ds
-                    if fraction != 1.0:
-                        t_b = min(t_b, t_last)
-                    if k != k_front:
-                        front = _sample(data, flat, nx, nxy, offset, gshape, ax + t_a * bx,
-                                        ay + t_a * by, az + t_a * bz, fkind, fp0, fp1, fp2,
-                                        radius, ntaps, wx, wy, wz)
-                        taken += 1
-                    back = _sample(data, flat, nx, nxy, offset, gshape, ax + t_b * bx,
-                                   ay + t_b * by, az + t_b * bz, fkind, fp0, fp1, fp2, radius,
-                                   ntaps, wx, wy, wz)
-                    taken += 1
-                    # A cut segment's own length: its opacity is exact, its colour's mean
-                    # emission that of a whole segment.
-                    length = ds
-                    if fraction != 1.0:
-                        length = t_b - t_a
-                        fraction = 1.0
-                    alpha, cr, cg, cb = _preintegrated(
-                        front, back, length, pre_start, pre_inv, pre_density, pre_psi,
-                        pre_emission, pre_step, pre_grey, col_start, col_inv, pre_mean)
-                    front = back
-                    k += 1
-                    k_front = k
+                # The two common filters unrolled, the others through the general loop.
+                if fkind == TENT:
+                    value = trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz)
+                elif fkind == CUBIC:
+                    value = tricubic(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz,
+                                     fp0, fp1, fp2)
+                elif ntaps == 4:
+                    value = separable4(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz,
+                                       fkind, fp0, fp1, fp2, radius)
+                else:
+                    value = reconstruct(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1,
+                                        fp2, radius, ntaps, wx, wy, wz)
+                taken += 1
+                k += 1
+                # Classify: segment opacity 1 - exp(-density ds) (eq 1.4) and colour
+                # E alpha (eq 1.9), from the table.
+                i, w = lookup((value - tstart) * tinv, ntab)
+                alpha = alpha_tab[i] + w * (alpha_tab[i + 1] - alpha_tab[i])
+                if not alpha > 0.0:
+                    continue  # a transparent segment adds exactly nothing
+                if grey and not by_gradient:
+                    cr = cg = cb = alpha  # white emission, no shading: colour = opacity
+                elif shade or by_gradient:
+                    gx_, gy_, gz_ = gradient(data, offset, gshape, ux, uy, uz, fkind, fp0,
+                                             fp1, fp2, radius, ntaps, wx, wy, wz, dx, dy,
+                                             dz)
+                    if headlight:
+                        lx, ly, lz = -d[0], -d[1], -d[2]
+                    else:
+                        lx, ly, lz = light[0], light[1], light[2]
+                    alpha, cr, cg, cb = classify_by_gradient(
+                        alpha, i, w, emit_tab, gx_ * inv[0], gy_ * inv[1], gz_ * inv[2],
+                        by_gradient, ramp_x, ramp_y, shade, lx, ly, lz, d[0], d[1], d[2],
+                        ka, kd, ks, shininess)
                     if not alpha > 0.0:
                         continue
-                    if shade or by_gradient:
-                        # The gradient at the segment's middle modulates the segment.
-                        gx_, gy_, gz_ = gradient(data, offset, gshape, ux, uy, uz, fkind, fp0,
-                                                 fp1, fp2, radius, ntaps, wx, wy, wz, dx, dy,
-                                                 dz)
-                        if headlight:
-                            lx, ly, lz = -d[0], -d[1], -d[2]
-                        else:
-                            lx, ly, lz = light[0], light[1], light[2]
-                        alpha, cr, cg, cb = modulate_by_gradient(
-                            alpha, cr, cg, cb, gx_ * inv[0], gy_ * inv[1], gz_ * inv[2],
-                            by_gradient, ramp_x, ramp_y, shade, lx, ly, lz, d[0], d[1], d[2],
-                            ka, kd, ks, shininess)
-                        if not alpha > 0.0:
-                            continue
                 else:
-                    # The two common filters unrolled, the others through the general loop.
-                    if fkind == TENT:
-                        value = trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz)
-                    elif fkind == CUBIC:
-                        value = tricubic(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz,
-                                         fp0, fp1, fp2)
-                    elif ntaps == 4:
-                        value = separable4(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz,
-                                           fkind, fp0, fp1, fp2, radius)
-                    else:
-                        value = reconstruct(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1,
-                                            fp2, radius, ntaps, wx, wy, wz)
-                    taken += 1
-                    k += 1
-                    # Classify: segment opacity 1 - exp(-density ds) (eq 1.4) and colour
-                    # E alpha (eq 1.9), from the table.
-                    i, w = lookup((value - tstart) * tinv, ntab)
-                    alpha = alpha_tab[i] + w * (alpha_tab[i + 1] - alpha_tab[i])
-                    if not alpha > 0.0:
-                        continue  # a transparent segment adds exactly nothing
-                    if grey and not by_gradient:
-                        cr = cg = cb = alpha  # white emission, no shading: colour = opacity
-                    elif shade or by_gradient:
-                        gx_, gy_, gz_ = gradient(data, offset, gshape, ux, uy, uz, fkind, fp0,
-                                                 fp1, fp2, radius, ntaps, wx, wy, wz, dx, dy,
-                                                 dz)
-                        if headlight:
-                            lx, ly, lz = -d[0], -d[1], -d[2]
-                        else:
-                            lx, ly, lz = light[0], light[1], light[2]
-                        alpha, cr, cg, cb = classify_by_gradient(
-                            alpha, i, w, emit_tab, gx_ * inv[0], gy_ * inv[1], gz_ * inv[2],
-                            by_gradient, ramp_x, ramp_y, shade, lx, ly, lz, d[0], d[1], d[2],
-                            ka, kd, ks, shininess)
-                        if not alpha > 0.0:
-                            continue
-                    else:
-                        cr = color_tab[i, 0] + w * (color_tab[i + 1, 0] - color_tab[i, 0])
-                        cg = color_tab[i, 1] + w * (color_tab[i + 1, 1] - color_tab[i, 1])
-                        cb = color_tab[i, 2] + w * (color_tab[i + 1, 2] - color_tab[i, 2])
+                    cr = color_tab[i, 0] + w * (color_tab[i + 1, 0] - color_tab[i, 0])
+                    cg = color_tab[i, 1] + w * (color_tab[i + 1, 1] - color_tab[i, 1])
+                    cb = color_tab[i, 2] + w * (color_tab[i + 1, 2] - color_tab[i, 2])
                 if fraction != 1.0:  # a segment cut by the volume's face
                     part = _part_of_segment(alpha, fraction)
                     cr *= part / alpha
