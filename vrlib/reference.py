@@ -87,12 +87,10 @@ class _Segments:
         if ramp is not None:
             omega = omega * ramp.factor(np.linalg.norm(grad, axis=-1))
         if shading is not None:
-            view_dir = -self.directions[ray]
-            factor = np.empty(values.shape)
-            spec = np.empty(values.shape)
-            for i, v in enumerate(view_dir):  # Phong takes one view direction at a time
-                factor[i] = shading.factor(grad[i], v)
-                spec[i] = shading.highlight(grad[i], v)
+            # One view direction per segment, the same at each of its nodes.
+            view_dir = np.broadcast_to(-self.directions[ray][:, None, :], grad.shape)
+            factor = shading.factor(grad, view_dir)
+            spec = shading.highlight(grad, view_dir)
             emit = emit * factor[..., None] + spec[..., None]
         tau = half * (omega @ _W)
         inner = half[:, None] * (omega @ _S.T)  # int_a^{t_i} omega, at every node

@@ -18,7 +18,7 @@ from chapters.ch11_tolerance._cases import TOLERANCES, VIEWS, analytic_scenes, r
 from chapters.common import by_profile, progress, result_path, write_json
 from vrlib.tolerance import STEP_SHARE, TERM_SHARE
 
-SIZE = by_profile(96, 192)
+SIZE = by_profile(128, 256)
 #: The fixed settings searched: steps 2 down to 1/64 voxel, a factor sqrt(2) apart.
 GRID_STEPS = [float(2.0 ** (0.5 * k)) for k in range(2, -13, -1)]
 CLASSIFICATIONS = ["point", "preintegrated"]
