@@ -97,6 +97,18 @@ def reconstruct_naive(volume, filt, points_index, *, gradient=False):
     return (out, grad) if gradient else out
 
 
+def chord(o, d, lo, hi):
+    """Where the ray ``o + t d`` (t >= 0) runs inside the box ``[lo, hi]``: ``(t_in, t_out)``,
+    with ``t_out <= t_in`` when it misses."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ta, tb = (lo - o) / d, (hi - o) / d
+    inside = d != 0
+    if np.any(~inside & ((o < lo) | (o > hi))):
+        return 0.0, 0.0
+    return (max(0.0, np.max(np.minimum(ta, tb)[inside])),
+            np.min(np.maximum(ta, tb)[inside]))
+
+
 def raycast_naive(volume, view, filt, transfer, step, segment_ends="lattice"):
     """Ray casting by the book: samples at t = (k + 1/2) ds inside the volume box, opacity
     1 - exp(-density ds) (eq 1.4), colour E alpha (eq 1.9), composited front to back.
@@ -112,13 +124,7 @@ def raycast_naive(volume, view, filt, transfer, step, segment_ends="lattice"):
     for r in range(view.height):
         for c in range(view.width):
             o, d = origins[r, c], directions[r, c]
-            with np.errstate(divide="ignore", invalid="ignore"):
-                ta, tb = (lo - o) / d, (hi - o) / d
-            inside = d != 0
-            if np.any(~inside & ((o < lo) | (o > hi))):
-                continue
-            t_in = max(0.0, np.max(np.minimum(ta, tb)[inside]))
-            t_out = np.min(np.maximum(ta, tb)[inside])
+            t_in, t_out = chord(o, d, lo, hi)
             if not t_out > t_in:
                 continue
             if segment_ends == "exact":
@@ -174,13 +180,7 @@ def raycast_preintegrated_naive(volume, view, filt, transfer, step):
     for r in range(view.height):
         for c in range(view.width):
             o, d = origins[r, c], directions[r, c]
-            with np.errstate(divide="ignore", invalid="ignore"):
-                ta, tb = (lo - o) / d, (hi - o) / d
-            inside = d != 0
-            if np.any(~inside & ((o < lo) | (o > hi))):
-                continue
-            t_in = max(0.0, np.max(np.minimum(ta, tb)[inside]))
-            t_out = np.min(np.maximum(ta, tb)[inside])
+            t_in, t_out = chord(o, d, lo, hi)
             if not t_out > t_in:
                 continue
             k = np.arange(math.floor(t_in / ds), math.ceil(t_out / ds))

@@ -305,12 +305,24 @@ def _step_segment(front, back, length, start, inv, density, emission, grey):
 
 
 @jit(inline="always")
-def _ray_start(o, d, box_lo, box_hi, vol_lo, vol_hi, exact, origin, inv, ds):
-    """Where ray ``o + t d`` takes samples: ``(t_in, t_out)`` in the box ``[box_lo,
-    box_hi]`` (none when ``t_out <= t_in``), its index position ``a + t b``, the first
-    segment ``k``, and with ``exact`` the segments ``k_first`` and ``k_last`` that the
-    volume's faces cut at ``t_first`` and ``t_last`` (-1 without; a cut segment's sample may
-    lie before segment ``k``'s, so ``k`` starts there)."""
+def _pixel_start(r, c, camera, height, width, mask, out, box_lo, box_hi, vol_lo, vol_hi,
+                 exact, origin, inv, ds):
+    """Pixel ``(r, c)``'s ray (cleared to transparent in ``out``) and where it takes samples:
+    ``(hit, d, t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, t_first, t_last)``.
+    ``hit`` is False for a pixel outside the image or the ``mask``, or a ray that misses the
+    box ``[box_lo, box_hi]``; ``d`` is the ray's direction, ``[t_in, t_out)`` its stretch in
+    the box, ``a + t b`` its index position, ``k`` the first segment; with ``exact``, the
+    segments ``k_first`` and ``k_last`` that the volume's faces cut at ``t_first`` and
+    ``t_last`` (-1 without; a cut segment's sample may lie before segment ``k``'s, so ``k``
+    starts there)."""
+    if r >= height or c >= width:
+        return (False, (0.0, 0.0, 0.0), 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, -1, -1,
+                0.0, 0.0)
+    o, d = pixel_ray(camera, height, width, r, c)
+    out[r, c, 0] = 0.0
+    out[r, c, 1] = 0.0
+    out[r, c, 2] = 0.0
+    out[r, c, 3] = 0.0
     t_in, t_out = ray_box(o, d, box_lo, box_hi)
     t_in = max(t_in, 0.0)
     # Index position of sample k: a + t b, the same for every brick of a volume.
@@ -320,17 +332,18 @@ def _ray_start(o, d, box_lo, box_hi, vol_lo, vol_hi, exact, origin, inv, ds):
     bx = d[0] * inv[0]
     by = d[1] * inv[1]
     bz = d[2] * inv[2]
-    k = math.ceil(t_in / ds - 0.5)
+    k = math.ceil(t_in / ds - 0.5) if t_out > t_in else 0
     k_first = k_last = -1
     t_first = t_last = 0.0
-    if exact:
+    if exact and t_out > t_in:
         t_first, t_last = ray_box(o, d, vol_lo, vol_hi)
         t_first = max(t_first, 0.0)
         k_first = math.floor(t_first / ds)
         k_last = math.ceil(t_last / ds) - 1
         if k - 1 == k_first or k - 1 == k_last:
             k -= 1
-    return t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, t_first, t_last
+    hit = bool(mask[r, c]) and t_out > t_in
+    return hit, d, t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, t_first, t_last
 
 
 @parallel_jit
@@ -383,18 +396,10 @@ def _tile_preintegrated(tile_id, data, flat, inv, fine_counts, coarse_counts, of
     for p in range(tile_h * tile_w):
         r = row0 + p // tile_w
         c = col0 + p % tile_w
-        if r >= height or c >= width:
-            continue
-        o, d = pixel_ray(camera, height, width, r, c)
-        out[r, c, 0] = 0.0
-        out[r, c, 1] = 0.0
-        out[r, c, 2] = 0.0
-        out[r, c, 3] = 0.0
-        if not mask[r, c]:
-            continue
-        t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, t_first, t_last = _ray_start(
-            o, d, box_lo, box_hi, vol_lo, vol_hi, True, origin, inv, ds)
-        if not t_out > t_in:
+        hit, d, t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, t_first, t_last = \
+            _pixel_start(r, c, camera, height, width, mask, out, box_lo, box_hi, vol_lo,
+                         vol_hi, True, origin, inv, ds)
+        if not hit:
             continue
         # One compiled loop per reconstruction: the tent filter's holds no call.
         if fkind == TENT:
@@ -492,18 +497,10 @@ def _tile(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, 
     for p in range(tile_h * tile_w):
         r = row0 + p // tile_w
         c = col0 + p % tile_w
-        if r >= height or c >= width:
-            continue
-        o, d = pixel_ray(camera, height, width, r, c)
-        out[r, c, 0] = 0.0
-        out[r, c, 1] = 0.0
-        out[r, c, 2] = 0.0
-        out[r, c, 3] = 0.0
-        if not mask[r, c]:
-            continue
-        t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, t_first, t_last = _ray_start(
-            o, d, box_lo, box_hi, vol_lo, vol_hi, exact, origin, inv, ds)
-        if not t_out > t_in:
+        hit, d, t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, t_first, t_last = \
+            _pixel_start(r, c, camera, height, width, mask, out, box_lo, box_hi, vol_lo,
+                         vol_hi, exact, origin, inv, ds)
+        if not hit:
             continue
         acc_r = 0.0
         acc_g = 0.0

@@ -62,6 +62,19 @@ def phong(gx, gy, gz, lx, ly, lz, dx, dy, dz, ka, kd, ks, shininess):
 
 
 @jit(inline="always")
+def opacity_by_gradient(alpha, gx, gy, gz, ramp_x, ramp_y):
+    """Opacity ``alpha`` with its density multiplied by the piecewise-linear factor through
+    ``(ramp_x, ramp_y)`` of the gradient magnitude ``|g|``: ``1 - (1 - alpha)^factor``
+    (eq 1.4); 0 where the factor is 0."""
+    factor = piecewise_linear(ramp_x, ramp_y, math.sqrt(gx * gx + gy * gy + gz * gz))
+    if not factor > 0.0:
+        return 0.0
+    if factor < 1.0 and alpha < 1.0:
+        return -math.expm1(factor * math.log1p(-alpha))
+    return alpha
+
+
+@jit(inline="always")
 def classify_by_gradient(alpha, i, w, emit_tab, gx, gy, gz, by_gradient, ramp_x, ramp_y,
                          shade, lx, ly, lz, dx, dy, dz, ka, kd, ks, shininess):
     """A sample's segment opacity and premultiplied colour when its classification needs its
@@ -71,11 +84,9 @@ def classify_by_gradient(alpha, i, w, emit_tab, gx, gy, gz, by_gradient, ramp_x,
     ``shade`` the emission ``emit_tab`` is Phong-shaded for light direction ``l`` and ray
     direction ``d``. Returns ``(alpha, r, g, b)``; ``alpha = 0`` adds nothing."""
     if by_gradient:
-        factor = piecewise_linear(ramp_x, ramp_y, math.sqrt(gx * gx + gy * gy + gz * gz))
-        if not factor > 0.0:
+        alpha = opacity_by_gradient(alpha, gx, gy, gz, ramp_x, ramp_y)
+        if not alpha > 0.0:
             return 0.0, 0.0, 0.0, 0.0
-        if factor < 1.0 and alpha < 1.0:
-            alpha = -math.expm1(factor * math.log1p(-alpha))
     er = emit_tab[i, 0] + w * (emit_tab[i + 1, 0] - emit_tab[i, 0])
     eg = emit_tab[i, 1] + w * (emit_tab[i + 1, 1] - emit_tab[i, 1])
     eb = emit_tab[i, 2] + w * (emit_tab[i + 1, 2] - emit_tab[i, 2])
@@ -96,15 +107,13 @@ def modulate_by_gradient(alpha, r, g, b, gx, gy, gz, by_gradient, ramp_x, ramp_y
     Phong-shaded (``colour * factor + highlight * alpha``), as :func:`classify_by_gradient`
     does for one value. Returns ``(alpha, r, g, b)``."""
     if by_gradient:
-        factor = piecewise_linear(ramp_x, ramp_y, math.sqrt(gx * gx + gy * gy + gz * gz))
-        if not factor > 0.0:
+        scaled = opacity_by_gradient(alpha, gx, gy, gz, ramp_x, ramp_y)
+        if not scaled > 0.0:
             return 0.0, 0.0, 0.0, 0.0
-        if factor < 1.0 and alpha < 1.0:
-            scaled = -math.expm1(factor * math.log1p(-alpha))
-            r *= scaled / alpha
-            g *= scaled / alpha
-            b *= scaled / alpha
-            alpha = scaled
+        r *= scaled / alpha
+        g *= scaled / alpha
+        b *= scaled / alpha
+        alpha = scaled
     if shade:
         lit, spec = phong(gx, gy, gz, lx, ly, lz, dx, dy, dz, ka, kd, ks, shininess)
         return alpha, r * lit + spec * alpha, g * lit + spec * alpha, b * lit + spec * alpha
