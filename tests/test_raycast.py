@@ -157,14 +157,17 @@ def test_exact_segment_ends_converge_at_second_order():
     assert errors["exact"][0] * 5 < errors["lattice"][0]
 
 
+@pytest.mark.parametrize("options", [{}, {"segment_ends": "exact"},
+                                     {"classification": "preintegrated"},
+                                     {"skip_budget": 1e-2}, {"tolerance": 1e-3}], ids=str)
 @pytest.mark.parametrize("filt", ["trilinear", "catmull-rom", "gaussian"])
-def test_bit_identical_for_one_and_two_threads(filt):
+def test_bit_identical_for_one_and_two_threads(filt, options):
     if numba.config.NUMBA_NUM_THREADS < 2:
         pytest.skip("numba sees a single CPU: nothing to compare")
     vol = data_gen.make_field("marschner-lobb").sample(24)
     view = View.orbit(azimuth=20, elevation=35, size=70)
-    one = render(vol, view, filter=filt, threads=1)
-    two = render(vol, view, filter=filt, threads=2)
+    one = render(vol, view, filter=filt, threads=1, **options)
+    two = render(vol, view, filter=filt, threads=2, **options)
     assert np.array_equal(one.rgba, two.rgba)
     assert one.stats.samples == two.stats.samples
 

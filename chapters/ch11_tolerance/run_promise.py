@@ -98,7 +98,11 @@ def main():
                                                       for c in cases if "rmse" in c),
                     "ratio_median": float(np.median(ratios)) if ratios else None,
                     "ratio_max": float(np.max(ratios)) if ratios else None,
-                    "timed": len(ratios), "within_1_5": sum(r <= 1.5 for r in ratios)}})
+                    "timed": len(ratios), "within_1_5": sum(r <= 1.5 for r in ratios),
+                    "missed": [f"{c['label']}, {c['view']}, tolerance {c['tolerance']:g} "
+                               f"({c['rmse'] / c['tolerance']:.2f} of it; reference: "
+                               f"{c['reference']} image)"
+                               for c in cases if "rmse" in c and c["rmse"] > c["tolerance"]]}})
 
 
 if __name__ == "__main__":
