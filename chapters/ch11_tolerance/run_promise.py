@@ -3,8 +3,9 @@
 template, at tolerances 1e-2 to 1e-4. For each case: the error achieved against the exact
 image of the field the filter reconstructs (the real volume: against a ray cast at 1/64
 voxel with exact ends, whose own error is estimated from the one at 1/32), the estimate the
-render reported, its time, and the time of the fastest fixed setting that meets the same tolerance (a grid search over the step, with point
-and pre-integrated classification, exact ends, no early termination). Writes
+render reported, its time, and the time of the fastest fixed setting that meets the same
+tolerance (a grid search over the step, with point and pre-integrated classification, exact
+ends, no early termination). Writes
 ``build/results/ch11_tolerance/promise.json``.
 """
 
