@@ -103,6 +103,7 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
     extent = volume.extent
     box_lo, box_hi = extent[:, 0].copy(), extent[:, 1].copy()
     ds = step * float(volume.spacing.min())
+    value_range = reconstructed_range(volume, filt)
     skip = bound = None
     if skip_budget > 0.0 and not empty_space_skipping:
         raise ValueError("skip_budget > 0 skips blocks: it needs empty_space_skipping=True")
@@ -110,8 +111,7 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
         densities = block_densities(volume, filt, transfer, block=BLOCK)
         empty = densities <= 0.0
         if skip_budget > 0.0:
-            bound = skip_bounds(densities, volume, transfer, ds, reconstructed_range(volume,
-                                                                                   filt))
+            bound = skip_bounds(densities, volume, transfer, ds, value_range)
         # With nothing to skip, checking would only cost time.
         if empty.any() or (bound is not None and np.any(bound <= skip_budget)):
             box_lo, box_hi = visible_box(volume, empty, BLOCK, box_lo, box_hi)
@@ -122,7 +122,7 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
     rgba, taken = cast_rays(
         volume.data, offset=(0, 0, 0), global_shape=volume.shape, origin=volume.origin,
         spacing=volume.spacing, box=(box_lo, box_hi), view=view, filt=filt, transfer=transfer,
-        ds=ds, value_range=reconstructed_range(volume, filt),
+        ds=ds, value_range=value_range,
         early_termination=early_termination, skip=skip, exact_ends=segment_ends == "exact",
         preintegrated=preint, bound=bound, budget=skip_budget,
     )
