@@ -143,16 +143,18 @@ class ReconstructedField:
 
     def __call__(self, points):
         """Reconstructed values at world points ``(..., 3)``."""
-        pts = np.asarray(points, dtype=np.float64)
-        flat = np.clip(pts.reshape(-1, 3), self.bounds[:, 0], self.bounds[:, 1])
-        return reconstruct(self.volume, flat, filter=self.filter).reshape(pts.shape[:-1])
+        return self._at(points, derivative=False)
 
     def gradient(self, points):
         """Gradient of the reconstruction at world points ``(..., 3)``, per world unit."""
+        return self._at(points, derivative=True)
+
+    def _at(self, points, *, derivative):
+        # Quadrature nodes that rounding puts a hair outside the box are moved onto it.
         pts = np.asarray(points, dtype=np.float64)
         flat = np.clip(pts.reshape(-1, 3), self.bounds[:, 0], self.bounds[:, 1])
-        return reconstruct(self.volume, flat, filter=self.filter,
-                           derivative=True).reshape(pts.shape)
+        out = reconstruct(self.volume, flat, filter=self.filter, derivative=derivative)
+        return out.reshape(pts.shape if derivative else pts.shape[:-1])
 
     def breakpoints(self, origins, directions):
         """Ray parameters ``(n_rays, m)`` where each ray crosses a plane on which the

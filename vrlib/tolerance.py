@@ -99,14 +99,15 @@ def render_within(volume, view, *, filt, transfer, tolerance, empty_space_skippi
     if pilot_view.height >= view.height and pilot_view.width >= view.width:
         pilot_view = view
     target = STEP_SHARE * tolerance
-    steps, images, differences = [], [], []
+    steps, differences = [], []
     step = MAX_STEP
-    predicted = None
+    previous = predicted = None
     while True:
         steps.append(step)
-        images.append(render_raycast(volume, pilot_view, step=step, **options))
-        if len(images) >= 2:
-            differences.append(rmse(images[-2], images[-1]))
+        pilot = render_raycast(volume, pilot_view, step=step, **options)
+        if previous is not None:
+            differences.append(rmse(previous, pilot))
+        previous = pilot
         if len(differences) >= 2:
             predicted, error_at = _predict(steps, differences, target)
             if predicted >= 0.5 * steps[-1] or step / 2.0 < MIN_STEP:
@@ -117,8 +118,8 @@ def render_within(volume, view, *, filt, transfer, tolerance, empty_space_skippi
         raise ValueError(
             f"tolerance={tolerance:g} is out of reach of ray casting with the {filt.name} "
             f"filter here: it would need a step below {MIN_STEP:g} voxel, where the error "
-            f"along rays is still about {reach / STEP_SHARE:.2g}; ask for a tolerance of at "
-            f"least {reach / STEP_SHARE:.2g}")
+            f"along rays is still about {reach:.2g}; ask for a tolerance of at least "
+            f"{reach / STEP_SHARE:.2g}")
     step = float(min(predicted, MAX_STEP))
     pilot_seconds = time.perf_counter() - start
     image = render_raycast(volume, view, step=step, **options)
