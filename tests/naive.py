@@ -109,13 +109,17 @@ def chord(o, d, lo, hi):
             np.min(np.maximum(ta, tb)[inside]))
 
 
-def raycast_naive(volume, view, filt, transfer, step, segment_ends="lattice"):
+def raycast_naive(volume, view, filt, transfer, step, segment_ends="lattice", *,
+                  multiplier=None, block=8):
     """Ray casting by the book: samples at t = (k + 1/2) ds inside the volume box, opacity
     1 - exp(-density ds) (eq 1.4), colour E alpha (eq 1.9), composited front to back.
 
     With ``segment_ends="exact"`` the ray's stretch inside the box is cut into the lattice's
     segments ``[k ds, (k + 1) ds)``, each sampled at its own middle with opacity
-    ``1 - exp(-density length)``: the ends are the only cut segments."""
+    ``1 - exp(-density length)``: the ends are the only cut segments.
+
+    With ``multiplier`` (per block of ``block`` cells, a power of two), adaptive steps: the
+    segments are merged into long ones (:func:`long_segments`)."""
     ds = step * float(volume.spacing.min())
     volume = coefficient_volume_naive(volume, filt)
     origins, directions = view.rays()
@@ -134,12 +138,17 @@ def raycast_naive(volume, view, filt, transfer, step, segment_ends="lattice"):
             else:
                 k = np.arange(math.ceil(t_in / ds - 0.5), math.ceil(t_out / ds - 0.5) + 1)
                 t = (k + 0.5) * ds
-                t = t[(t >= t_in) & (t < t_out)]
-                length = ds
+                keep = (t >= t_in) & (t < t_out)
+                k, t = k[keep], t[keep]
+                length = np.full(t.shape, ds)
+            if multiplier is not None:
+                t, length = long_segments(volume, o, d, k, t, length, ds, multiplier, block,
+                                          cut=segment_ends == "exact")
+            length = length[:, None] if np.ndim(length) else length
             points = o + t[:, None] * d
             values, grad = reconstruct_naive(volume, filt, volume.world_to_index(points),
                                              gradient=True)
-            alpha = -np.expm1(-transfer.opacity_density(values) * length)
+            alpha = -np.expm1(-transfer.opacity_density(values) * np.ravel(length))
             emit = transfer.emission(values)
             if transfer.shading is not None:
                 world_grad = grad / volume.spacing
@@ -151,6 +160,45 @@ def raycast_naive(volume, view, filt, transfer, step, segment_ends="lattice"):
                 acc = acc + (1.0 - acc[3]) * segment
             image[r, c] = acc
     return image
+
+
+def long_segments(volume, o, d, k, t, length, ds, multiplier, block, *, cut):
+    """Adaptive steps by the book: walking the ray's segments ``k`` (samples ``t``, lengths
+    ``length``) front to back, segment ``k`` starts a long one of ``m`` segments when ``m``
+    (a power of two, at most the multiplier of the block of ``block`` cells that holds
+    sample ``k``) divides ``k`` and the long segment lies inside that block's stretch of the
+    ray, holding no cut segment (``cut``: the first and last are). Returns the samples and
+    lengths after merging: a long segment sampled at its middle, ``m ds`` long."""
+    a = volume.world_to_index(o[None])[0]
+    b = d / volume.spacing
+    counts = np.array(multiplier.shape[::-1])  # x y z
+    first_cut, last_cut = (k[0], k[-1]) if cut else (-1, -1)
+    out_t, out_len = [], []
+    i = 0
+    while i < len(k):
+        u = a + t[i] * b
+        cell = np.clip(np.floor(np.floor(u) / block).astype(int), 0, counts - 1)
+        with np.errstate(divide="ignore"):
+            ends = (np.stack([cell, cell + 1]) * block - a) / b
+        moving = b != 0
+        enter = np.max(np.min(ends, axis=0)[moving])
+        leave = np.min(np.max(ends, axis=0)[moving])
+        m = int(multiplier[cell[2], cell[1], cell[0]])
+        while m > 1:
+            k0 = k[i] - k[i] % m
+            if (k0 == k[i] and k0 * ds >= enter and (k0 + m) * ds <= leave
+                    and k0 > first_cut and (last_cut < 0 or k0 + m <= last_cut)):
+                break
+            m //= 2
+        if m > 1:
+            out_t.append((k[i] + 0.5 * m) * ds)
+            out_len.append(m * ds)
+            i += m
+        else:
+            out_t.append(t[i])
+            out_len.append(length[i] if np.ndim(length) else length)
+            i += 1
+    return np.array(out_t), np.array(out_len)
 
 
 def preintegrated_segment(transfer, front, back, length, *, profile="linear", pieces=400):

@@ -19,6 +19,7 @@ from vrlib import validate
 from vrlib._kernels import raycast as _kernel
 from vrlib._kernels.filters import TENT
 from vrlib._scheduling import balanced_order
+from vrlib.adaptive import step_multipliers
 from vrlib.image import Image, RenderStats
 from vrlib.prefilter import Tally, prepared
 from vrlib.skipping import BLOCK, block_densities, coarsen, footprint_mask, visible_box
@@ -62,7 +63,7 @@ CLASSIFICATIONS = ("point", "preintegrated")
 
 def render_raycast(volume, view, *, filt, transfer, step, early_termination,
                    empty_space_skipping, segment_ends=None, classification="point",
-                   skip_budget=0.0):
+                   skip_budget=0.0, step_budget=0.0):
     """Ray-cast ``volume`` (arguments already validated by :func:`vrlib.render`).
 
     ``segment_ends="lattice"`` lets every sample stand for a whole step, also where the
@@ -82,8 +83,14 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
     ``skip_budget`` (>= 0, premultiplied colour units) lets each ray leave out blocks that
     are not empty, while the most those blocks could change any channel of its pixel
     (:func:`skip_bounds`) adds up to at most the budget; 0 skips only empty blocks.
+
+    ``step_budget`` (>= 0, the same units) lets one sample stand for 2, 4 or 8 steps in
+    blocks where the classified field changes slowly enough that no pixel moves by more than
+    the budget from the image at ``step`` (adaptive steps, :mod:`vrlib.adaptive`); 0 takes
+    every step. Point classification without shading or gradient opacity only.
     """
     skip_budget = validate.finite_number("skip_budget", skip_budget, low=0.0)
+    step_budget = validate.finite_number("step_budget", step_budget, low=0.0)
     validate.choice("classification", classification, CLASSIFICATIONS)
     preint = classification == "preintegrated"
     if segment_ends is None:
@@ -97,6 +104,17 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
         raise ValueError("classification='preintegrated' cannot take holes "
                          "(nan='transparent'): no value runs linearly into a hole; use "
                          "classification='point'")
+    if step_budget > 0.0:
+        if preint:
+            raise ValueError("step_budget > 0 (adaptive steps) is built for "
+                             "classification='point' only; pre-integration takes every step")
+        if transfer.needs_gradient:
+            raise ValueError("step_budget > 0 (adaptive steps) bounds the change of an "
+                             "unshaded field: leave out shading and gradient opacity, or use "
+                             "step_budget=0")
+        if not empty_space_skipping:
+            raise ValueError("step_budget > 0 keeps a step per block: it needs "
+                             "empty_space_skipping=True")
     start = time.perf_counter()
     tally = Tally()
     volume = prepared(volume, filt, tally)  # prefiltered filters: the 3-D coefficients
@@ -104,7 +122,7 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
     box_lo, box_hi = extent[:, 0].copy(), extent[:, 1].copy()
     ds = step * float(volume.spacing.min())
     value_range = reconstructed_range(volume, filt)
-    skip = bound = None
+    skip = bound = multiplier = None
     if skip_budget > 0.0 and not empty_space_skipping:
         raise ValueError("skip_budget > 0 skips blocks: it needs empty_space_skipping=True")
     if empty_space_skipping:
@@ -112,8 +130,16 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
         empty = densities <= 0.0
         if skip_budget > 0.0:
             bound = skip_bounds(densities, volume, transfer, ds, value_range)
-        # With nothing to skip, checking would only cost time.
-        if empty.any() or (bound is not None and np.any(bound <= skip_budget)):
+        if step_budget > 0.0:
+            multiplier = step_multipliers(volume, filt, transfer, ds, step_budget,
+                                          value_range=value_range,
+                                          brightest=brightest(transfer, value_range),
+                                          block=BLOCK)
+            if not np.any(multiplier > 1):
+                multiplier = None
+        # With nothing to skip or stretch, checking would only cost time.
+        if (empty.any() or (bound is not None and np.any(bound <= skip_budget))
+                or multiplier is not None):
             box_lo, box_hi = visible_box(volume, empty, BLOCK, box_lo, box_hi)
             if preint:  # a segment owned outside the box reaches half a step into it
                 box_lo = np.maximum(box_lo - 0.5 * ds, extent[:, 0])
@@ -124,7 +150,7 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
         spacing=volume.spacing, box=(box_lo, box_hi), view=view, filt=filt, transfer=transfer,
         ds=ds, value_range=value_range,
         early_termination=early_termination, skip=skip, exact_ends=segment_ends == "exact",
-        preintegrated=preint, bound=bound, budget=skip_budget,
+        preintegrated=preint, bound=bound, budget=skip_budget, multiplier=multiplier,
     )
     stats = RenderStats(
         samples=taken,
@@ -179,7 +205,7 @@ def brightest(transfer, value_range):
 
 def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, transfer, ds,
               value_range, early_termination, skip=None, exact_ends=False,
-              preintegrated=False, bound=None, budget=0.0):
+              preintegrated=False, bound=None, budget=0.0, multiplier=None):
     """Ray-cast samples ``data`` (all of a volume, or a brick of it with ghost samples): the
     ray caster's core, which the MPI renderers run on each brick or tile.
 
@@ -208,6 +234,9 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
         Per block of the skip grid, the most leaving it out can change a pixel
         (:func:`skip_bounds`); with ``budget > 0`` a ray leaves blocks out while their
         bounds add up to at most ``budget``.
+    multiplier : ndarray of int or None
+        Per block of the skip grid, how many steps one sample may stand for (adaptive steps,
+        :func:`vrlib.adaptive.step_multipliers`; point classification only), or None.
 
     Returns
     -------
@@ -243,18 +272,19 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
               np.asarray(box[0], np.float64), np.asarray(box[1], np.float64),
               *lattice_extent(global_shape, spacing, origin).T.copy())
     skips = (early_termination, *skip, np.zeros((1, 1, 1)) if bound is None else bound,
-             float(budget), *TILE, balanced_order(costs, numba.get_num_threads()), out, samples)
+             float(budget))
+    tiles = (*TILE, balanced_order(costs, numba.get_num_threads()), out, samples)
     if preintegrated:
         profile = "step" if filt.radius <= 0.5 else "linear"  # the box filter jumps
         _kernel.raycast_preintegrated(
             *layout, view.packed(), view.height, view.width, ds, *filt.code, filt.radius,
             filt.taps, *transfer.preintegrated_table(ds, *value_range, profile=profile),
-            *lighting, *by_gradient, *skips)
+            *lighting, *by_gradient, *skips, *tiles)
     else:
         grey = shading is None and bool(np.all(tables[4] == 1.0))  # colour equals opacity
         _kernel.raycast(
             *layout, bool(exact_ends), view.packed(), view.height, view.width, ds,
             *filt.code, filt.radius, filt.taps, *tables, *lighting, *by_gradient, *skips,
-            grey)
+            np.ones((1, 1, 1), np.int64) if multiplier is None else multiplier, *tiles, grey)
     np.clip(out[..., 3], 0.0, 1.0, out=out[..., 3])
     return out, int(samples.sum())

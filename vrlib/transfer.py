@@ -23,7 +23,7 @@ import numpy as np
 from vrlib import validate
 
 __all__ = ["TransferFunction", "Glow", "LookupTransfer", "Phong", "GradientOpacity",
-           "PreintegratedTable"]
+           "PreintegratedTable", "range_maximum"]
 
 
 class Phong:
@@ -426,6 +426,30 @@ class Glow(TransferFunction):
         return f"Glow({self.scale:g}{_extras_repr(self)})"
 
 
+def range_maximum(values, first, last):
+    """``max(values[first:last])`` for arrays of ``first < last`` (a sparse table).
+
+    Examples
+    --------
+    >>> range_maximum(np.array([1.0, 5.0, 2.0, 0.0]), np.array([0, 2]), np.array([2, 4]))
+    array([5., 2.])
+    """
+    first, last = np.asarray(first), np.asarray(last)
+    table = [np.asarray(values, dtype=np.float64)]  # table[lev][i] = max(values[i:i+2^lev])
+    span = 1
+    while 2 * span <= table[0].shape[0]:
+        table.append(np.maximum(table[-1][:-span], table[-1][span:]))
+        span *= 2
+    count = last - first
+    level = np.floor(np.log2(count)).astype(int)
+    peak = np.empty(first.shape)
+    for lev in np.unique(level):
+        sel = level == lev
+        span = 1 << lev
+        peak[sel] = np.maximum(table[lev][first[sel]], table[lev][last[sel] - span])
+    return peak
+
+
 class LookupTransfer(TransferFunction):
     """Tabulated transfer function: density and colour at evenly spaced values, interpolated.
 
@@ -528,19 +552,8 @@ class LookupTransfer(TransferFunction):
         last = np.searchsorted(grid, vmax, side="left")  # entries first .. last - 1
         has = last > first
         if np.any(has):
-            table = [self.density]  # table[lev][i] = max(density[i : i + 2**lev])
-            span = 1
-            while 2 * span <= self.density.shape[0]:
-                table.append(np.maximum(table[-1][:-span], table[-1][span:]))
-                span *= 2
-            f, n = first[has], last[has] - first[has]
-            level = np.floor(np.log2(n)).astype(int)
-            peak = np.empty(f.shape)
-            for lev in np.unique(level):
-                sel = level == lev
-                span = 1 << lev
-                peak[sel] = np.maximum(table[lev][f[sel]], table[lev][f[sel] + n[sel] - span])
-            best[has] = np.maximum(best[has], peak)
+            best[has] = np.maximum(best[has], range_maximum(self.density, first[has],
+                                                            last[has]))
         return float(best[0]) if scalar else best
 
 

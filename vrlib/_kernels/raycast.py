@@ -79,6 +79,36 @@ def _exit(ax, ay, az, bx, by, bz, cells, counts, ux, uy, uz):
     return t_exit
 
 
+@jit
+def _entry(ax, ay, az, bx, by, bz, cells, counts, ux, uy, uz):
+    """Ray parameter where the ray (index position ``a + t b``) enters the block that holds
+    ``(ux, uy, uz)``: :func:`_exit`'s other end."""
+    t_entry = -math.inf
+    for a, b, u, n in ((ax, bx, ux, counts[2]), (ay, by, uy, counts[1]),
+                       (az, bz, uz, counts[0])):
+        if b != 0.0:
+            block = _cell(u, cells, n)
+            edge = block * cells if b > 0.0 else (block + 1) * cells
+            t_entry = max(t_entry, (edge - a) / b)
+    return t_entry
+
+
+@jit(inline="always")
+def _long_segment(k, m, ds, t_enter, t_exit, k_first, k_last):
+    """The longest aligned segment ``[k0 ds, (k0 + m) ds)`` (``m`` a power of two, at most
+    the block's ``m``, ``k0`` a multiple of it) that holds segment ``k``, lies inside the
+    block's stretch ``[t_enter, t_exit]`` of the ray and holds no segment the volume's faces
+    cut: ``(k0, m)``, ``m = 1`` where none does. A function of ``k`` and the block alone, so
+    that every brick and rank finds the same long segments."""
+    while m > 1:
+        k0 = k - k % m
+        if (k0 * ds >= t_enter and (k0 + m) * ds <= t_exit and k0 > k_first
+                and (k_last < 0 or k0 + m <= k_last)):
+            return k0, m
+        m //= 2
+    return k, 1
+
+
 @jit(inline="always")
 def _cut_segment(k, ds, t_first, t_last):
     """Sample position and length (as a fraction of ``ds``) of segment ``k`` cut to the
@@ -432,8 +462,8 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
             fkind, fp0, fp1, fp2, radius, ntaps,
             tstart, tinv, alpha_tab, color_tab, emit_tab,
             shade, ka, kd, ks, shininess, light, headlight, ramp_x, ramp_y, by_gradient,
-            threshold, empty, coarse, block, mask, bound, budget, tile_h, tile_w, order, out,
-            samples, grey):
+            threshold, empty, coarse, block, mask, bound, budget, multiplier, tile_h, tile_w,
+            order, out, samples, grey):
     """Render ``out[row, col] = (r, g, b, a)`` premultiplied; count samples per tile.
 
     ``data`` holds the samples from global index ``offset`` on (the whole volume, or a brick
@@ -453,6 +483,9 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
     a ray also skips blocks that are not empty while the bounds ``bound`` (per block: the
     most a ray can change any channel by leaving the block out) of the blocks it skipped add
     up to at most ``budget``: each pixel changes by at most ``budget``.
+    Adaptive steps: where ``multiplier`` (per block of the skip grid, a power of two; a
+    ``(1, 1, 1)`` array of 1 turns them off) exceeds 1, one sample stands for that many
+    segments (:func:`_long_segment`, :mod:`vrlib.adaptive`).
     ``grey`` says the emission is 1 everywhere and unshaded, so colour equals opacity.
     ``by_gradient`` multiplies the density by the piecewise-linear factor through
     ``(ramp_x, ramp_y)`` of the gradient magnitude (per world unit).
@@ -470,8 +503,8 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
             box_lo, box_hi, vol_lo, vol_hi, exact, camera, height, width,
             ds, fkind, fp0, fp1, fp2, radius, ntaps, tstart, tinv, alpha_tab, color_tab,
             emit_tab, shade, ka, kd, ks, shininess, light, headlight, ramp_x, ramp_y,
-            by_gradient, threshold, empty, coarse, block, mask, bound, budget, tile_h, tile_w,
-            out, grey)
+            by_gradient, threshold, empty, coarse, block, mask, bound, budget, multiplier,
+            tile_h, tile_w, out, grey)
 
 
 @jit
@@ -479,7 +512,7 @@ def _tile(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, 
           box_lo, box_hi, vol_lo, vol_hi, exact, camera, height, width, ds, fkind, fp0, fp1, fp2,
           radius, ntaps, tstart, tinv, alpha_tab, color_tab, emit_tab, shade, ka, kd, ks,
           shininess, light, headlight, ramp_x, ramp_y, by_gradient, threshold, empty, coarse,
-          block, mask, bound, budget, tile_h, tile_w, out, grey):
+          block, mask, bound, budget, multiplier, tile_h, tile_w, out, grey):
     """Tile ``tile_id`` of :func:`raycast` (the same arguments): its pixels' rays, front to
     back, in a fixed order; returns the samples taken. ``flat`` is ``data`` raveled, ``inv``
     the inverse spacing, ``fine_counts`` and ``coarse_counts`` the skip grids' shapes."""
@@ -490,6 +523,7 @@ def _tile(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, 
     gz, gy, gx = gshape[0], gshape[1], gshape[2]
     ntab = alpha_tab.shape[0]
     plain = fkind == TENT and grey and not shade and not by_gradient and block == 0
+    adaptive = block > 0 and multiplier.shape == empty.shape
     row0 = (tile_id // tiles_across) * tile_h
     col0 = (tile_id % tiles_across) * tile_w
     wx, wy, wz, dx, dy, dz = tap_scratch()
@@ -541,6 +575,8 @@ def _tile(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, 
             # Samples before t_check lie in a block already found not empty: no check needed
             # (a sample that rounding puts in an empty block anyway adds exactly nothing).
             t_check = -math.inf if block > 0 else math.inf
+            m_block = 1  # the step multiplier of the block before t_check, entered at t_enter
+            t_enter = 0.0
             while True:
                 t = (k + 0.5) * ds
                 fraction = 1.0
@@ -562,6 +598,26 @@ def _tile(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, 
                     if k_next > k:
                         k = k_next
                         continue
+                    if adaptive:
+                        m_block = _block_bound(multiplier, block, ux, uy, uz)
+                        t_enter = _entry(ax, ay, az, bx, by, bz, block, fine_counts, ux, uy,
+                                         uz)
+                if m_block > 1:
+                    # Adaptive steps: one sample, at its middle, for an aligned run of m
+                    # segments inside this block (vrlib.adaptive bounds the change).
+                    k0, m = _long_segment(k, m_block, ds, t_enter, t_check, k_first, k_last)
+                    if m > 1:
+                        k = k0 + m - 1  # the last of the run: k + 1 follows it
+                        t = (k0 + 0.5 * m) * ds
+                        if t < t_in:  # another brick's sample
+                            k += 1
+                            continue
+                        if t >= t_out:
+                            break
+                        ux = ax + t * bx
+                        uy = ay + t * by
+                        uz = az + t * bz
+                        fraction = float(m)
                 # The two common filters unrolled, the others through the general loop.
                 if fkind == TENT:
                     value = trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz)
@@ -602,7 +658,7 @@ def _tile(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, 
                     cr = color_tab[i, 0] + w * (color_tab[i + 1, 0] - color_tab[i, 0])
                     cg = color_tab[i, 1] + w * (color_tab[i + 1, 1] - color_tab[i, 1])
                     cb = color_tab[i, 2] + w * (color_tab[i + 1, 2] - color_tab[i, 2])
-                if fraction != 1.0:  # a segment cut by the volume's face
+                if fraction != 1.0:  # a segment cut by the volume's face, or a long one
                     part = _part_of_segment(alpha, fraction)
                     cr *= part / alpha
                     cg *= part / alpha
