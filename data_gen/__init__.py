@@ -66,8 +66,8 @@ def make_field(name, **params):
     validate.choice("field", name, tuple(FIELDS))
     try:
         return FIELDS[name](**params)
-    except TypeError as exc:
-        raise TypeError(f"bad parameters for field {name!r}: {exc}") from None
+    except (TypeError, ValueError) as exc:
+        raise type(exc)(f"bad parameters for field {name!r}: {exc}") from None
 
 
 __all__ = [

@@ -28,7 +28,8 @@ __all__ = ["DATASETS", "load_dataset", "dataset_path", "load_mni_template"]
 DATASETS = {
     "mni152": "MNI152 T1 brain template, 2 mm voxels (nilearn)",
     "frog": "frog tissue labels 0..29 on a 500x470x136 grid (pyvista examples)",
-    "aniso": "brain MRI with anisotropic voxels, 58x58x24 (dipy test data)",
+    "aniso": "brain MRI with anisotropic voxels, 58x58x24, oblique: shown in its voxel axes "
+             "(dipy test data)",
     "brainsmall": "VolPack's example MRI head, 128x128x84, 8 bit (Debian libvolpack1-dev)",
 }
 
@@ -118,5 +119,7 @@ def load_dataset(name, **options):
     if name == "mni152":
         return load_mni_template(**options)
     path = dataset_path(name)
-    loader = {"frog": load_vtk, "aniso": load_nifti, "brainsmall": load_den}[name]
+    if name == "aniso":  # an oblique scan, shown in its own voxel axes
+        return load_nifti(path, **{"oblique": "voxel-axes", **options})
+    loader = {"frog": load_vtk, "brainsmall": load_den}[name]
     return loader(path, **options)

@@ -46,6 +46,10 @@ def _rays(origins, directions):
     return o, d / norm
 
 
+#: The most blobs a random field takes (each is summed at every sample).
+MAX_BLOBS = 10000
+
+
 class Field:
     """Base of the analytic fields.
 
@@ -253,6 +257,8 @@ class BlobSum(Field):
         ``sigma`` and ``amplitude`` are (low, high) ranges drawn uniformly.
         """
         count = validate.positive_int("count", count)
+        if count > MAX_BLOBS:
+            raise ValueError(f"count must be at most {MAX_BLOBS} blobs, got {count}")
         rng = np.random.default_rng(seed)
         centers = rng.uniform(-region, region, size=(count, 3))
         sigmas = rng.uniform(*sigma, size=count)

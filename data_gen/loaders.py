@@ -10,31 +10,55 @@ angles alone frame any volume (:meth:`vrlib.View.fitted`), so no rescaling is ne
 Every loader takes ``nan="transparent"`` to read NaN samples as holes (:mod:`vrlib.holes`);
 by default a file with NaN samples is refused.
 
-Orientation: NIfTI volumes are turned to the closest RAS+ axes of their affine (a LAS file
-renders as its RAS twin); DICOM slices are ordered along their normal. A rotation left over
-after that (an oblique acquisition) is not applied: the voxels stay on axis-aligned axes.
+Orientation is applied exactly or refused: NIfTI and NRRD volumes are turned to RAS+ by the
+flips and axis swaps their affine or space directions ask for (a LAS or LPS file renders as
+its RAS twin); an oblique or sheared grid is refused with a message, not rendered as a
+guess. DICOM slices are ordered along their normal.
+
+Files are untrusted (:mod:`data_gen.untrusted`): only regular files are read, a detached
+data file must lie in its header's folder, and every size a header claims is checked against
+the file's length and the memory available before anything is allocated.
 """
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import math
+import re
 from pathlib import Path
 
 import numpy as np
 
+from data_gen.untrusted import axis_aligned, check_allocation, regular_file, to_world_axes
 from vrlib import validate
 from vrlib.volume import Volume, fitted_extent
 
 __all__ = ["load", "load_npy", "load_nifti", "load_raw", "load_nrrd", "load_tiff", "load_vtk",
            "load_dicom", "load_den", "fitted_extent", "nifti_orientation", "nifti_volume",
-           "FORMATS"]
+           "FORMATS", "OBLIQUE"]
+
 
 def _existing(path):
+    """``path`` if it names a regular file (not a FIFO or device, which could block a read
+    or never end)."""
     path = Path(path)
-    if not path.is_file():
+    if not path.exists():
         raise FileNotFoundError(f"no volume file at {str(path)!r}")
-    return path
+    return regular_file(path)
+
+
+@contextlib.contextmanager
+def _quiet(library):
+    """A library's log lines held back while it reads: its complaints become the loader's
+    one-line errors."""
+    logger = logging.getLogger(library)
+    level = logger.level
+    logger.setLevel(logging.CRITICAL + 1)
+    try:
+        yield
+    finally:
+        logger.setLevel(level)
 
 
 def _unreadable(path, kind, error):
@@ -75,17 +99,26 @@ def load_npy(path, *, spacing=None, origin=None, extent=None, nan="error"):
     try:
         data = np.load(path, mmap_mode="r", allow_pickle=False)
     except (ValueError, OSError, EOFError) as error:
-        raise _unreadable(path, ".npy", error) from None
+        text = str(error)
+        if "allow_pickle" in text or "pickle" in text.lower():
+            text = "it holds Python objects, not a numeric array"
+        raise _unreadable(path, ".npy", text) from None
+    if not isinstance(data, np.ndarray) or data.dtype.kind not in "biuf":
+        raise ValueError(f"{path.name} is not a readable .npy file: it holds "
+                         f"{getattr(data, 'dtype', type(data).__name__)}, not real numbers")
+    check_allocation(data.size, data.dtype, path.name)
     return _volume(data, extent, spacing, origin, nan)
 
 
-def load_raw(path, shape, dtype, *, byteorder="little", offset=0, spacing=None, origin=None,
+def load_raw(path, shape, dtype, *, byteorder=None, offset=0, spacing=None, origin=None,
              extent=None, nan="error"):
     """Load headerless samples of ``shape = (nz, ny, nx)`` and ``dtype``, x varying fastest.
 
     Parameters
     ----------
-    byteorder : {"little", "big"}
+    byteorder : {"little", "big"}, optional
+        The samples' byte order; default the one ``dtype`` names (``">i2"``: big), else
+        little. A ``byteorder`` that contradicts ``dtype``'s is refused.
     offset : int
         Bytes to skip at the start (a header).
     spacing, origin, extent
@@ -103,12 +136,23 @@ def load_raw(path, shape, dtype, *, byteorder="little", offset=0, spacing=None, 
     shape = tuple(validate.positive_int("shape", n, minimum=2) for n in shape)
     if len(shape) != 3:
         raise ValueError(f"shape must be (nz, ny, nx), got {shape!r}")
-    validate.choice("byteorder", byteorder, ("little", "big"))
     try:
-        dt = np.dtype(dtype).newbyteorder("<" if byteorder == "little" else ">")
+        dt = np.dtype(dtype)
     except TypeError:
         raise ValueError(f"dtype must be a numpy sample type (uint8, int16, float32, ...), "
                          f"got {dtype!r}") from None
+    if dt.kind not in "biuf":
+        raise ValueError(f"dtype must be a numpy sample type (uint8, int16, float32, ...), "
+                         f"got {dtype!r}")
+    named = {">": "big", "<": "little"}.get(str(dtype).strip()[:1]) if isinstance(
+        dtype, str) else None
+    if byteorder is not None:
+        validate.choice("byteorder", byteorder, ("little", "big"))
+        if named is not None and named != byteorder and dt.itemsize > 1:
+            raise ValueError(f"dtype {dtype!r} is {named}-endian but byteorder={byteorder!r}: "
+                             "give the byte order once")
+    order = byteorder or named or "little"
+    dt = dt.newbyteorder("<" if order == "little" else ">")
     offset = validate.positive_int("offset", offset, minimum=0)
     expected = offset + math.prod(shape) * dt.itemsize
     actual = path.stat().st_size
@@ -117,6 +161,7 @@ def load_raw(path, shape, dtype, *, byteorder="little", offset=0, spacing=None, 
             f"raw file holds {actual} bytes, but shape {shape} of {dt.name} after {offset} "
             f"header bytes needs {expected}"
         )
+    check_allocation(math.prod(shape), dt, path.name)
     data = np.memmap(path, dtype=dt, mode="r", offset=offset, shape=shape)
     return _volume(data, extent, spacing, origin, nan)
 
@@ -149,7 +194,11 @@ def nifti_orientation(image):
     return ornt, spacing, canonical[:3, 3].copy()
 
 
-def load_nifti(path, *, frame=None, extent=None, nan="error"):
+#: What a loader does with an oblique or sheared grid (``oblique=``).
+OBLIQUE = ("refuse", "voxel-axes")
+
+
+def load_nifti(path, *, frame=None, extent=None, nan="error", oblique="refuse"):
     """Load a NIfTI volume (``.nii``, ``.nii.gz``) through nibabel, turned to RAS+.
 
     Voxel axes become ``(x, y, z)`` = (right, anterior, superior) after the flips and swaps
@@ -163,6 +212,11 @@ def load_nifti(path, *, frame=None, extent=None, nan="error"):
         The volume to take from a 4-D file (a time series); required there.
     extent : array_like, shape (3, 2), optional
         The world box instead of the affine's.
+    oblique : {"refuse", "voxel-axes"}
+        An affine that is not a signed permutation of the world axes (an oblique or
+        sheared acquisition) is refused, unless ``"voxel-axes"``: then the voxel grid is
+        rendered on its closest world axes with its voxel sizes and the rotation left out
+        (the image shows the scan in its own axes, not in world space).
 
     Examples
     --------
@@ -177,14 +231,39 @@ def load_nifti(path, *, frame=None, extent=None, nan="error"):
     import nibabel
 
     path = _existing(path)
+    with _quiet("nibabel"):
+        try:
+            image = nibabel.load(path)
+        except Exception as error:  # nibabel raises many kinds on a corrupt header
+            raise _unreadable(path, "NIfTI", error) from None
+        _check_nifti_size(image, path)
+        return nifti_volume(image, path.name, frame=frame, extent=extent, nan=nan,
+                            oblique=oblique)
+
+
+def _check_nifti_size(image, path):
+    """Refuse a NIfTI header whose samples would not fit in memory, or (uncompressed) in the
+    file, before any is read."""
+    header = image.header
     try:
-        image = nibabel.load(path)
-    except (OSError, EOFError, ValueError, nibabel.filebasedimages.ImageFileError) as error:
+        shape = tuple(int(n) for n in image.shape)
+        dtype = np.dtype(header.get_data_dtype())
+        offset = int(header.get_data_offset())
+    except Exception as error:
         raise _unreadable(path, "NIfTI", error) from None
-    return nifti_volume(image, path.name, frame=frame, extent=extent, nan=nan)
+    if len(shape) < 3 or min(shape) < 1 or offset < 0:
+        raise ValueError(f"{path.name} is not a readable NIfTI file: shape {shape}, data "
+                         f"offset {offset}")
+    if not path.name.lower().endswith(".gz"):
+        needed = offset + math.prod(shape) * dtype.itemsize
+        if path.stat().st_size < needed:
+            raise ValueError(f"{path.name} holds {path.stat().st_size} bytes, but its header "
+                             f"claims {needed} ({'x'.join(map(str, shape))} of {dtype.name} "
+                             f"after {offset} header bytes): truncated?")
+    check_allocation(math.prod(shape[:3]), dtype, path.name)
 
 
-def nifti_volume(image, name, *, frame=None, extent=None, nan="error"):
+def nifti_volume(image, name, *, frame=None, extent=None, nan="error", oblique="refuse"):
     """The volume of a loaded nibabel image (as :func:`load_nifti`; ``name`` for messages).
 
     Examples
@@ -196,6 +275,7 @@ def nifti_volume(image, name, *, frame=None, extent=None, nan="error"):
     """
     from nibabel import orientations
 
+    validate.choice("oblique", oblique, OBLIQUE)
     shape = tuple(int(n) for n in image.shape)
     if len(shape) not in (3, 4):
         raise ValueError(f"{name}: a NIfTI volume must be 3-D (or 4-D with frame=), got "
@@ -208,10 +288,21 @@ def nifti_volume(image, name, *, frame=None, extent=None, nan="error"):
         # Unscaled samples keep their type (an uncompressed file stays memory-mapped).
         data = np.asarray(proxy[..., _frame(name, shape, frame)] if len(shape) == 4
                           else proxy, dtype=np.float64 if scaled else None)
-    except (OSError, EOFError, ValueError) as error:
+    except Exception as error:  # nibabel's proxies raise many kinds on corrupt data
         if str(error).startswith("frame"):
             raise
         raise ValueError(f"{name} is not a readable NIfTI file: {error}") from None
+    affine = np.asarray(image.affine, dtype=np.float64)
+    if not np.all(np.isfinite(affine)):
+        raise ValueError(f"{name}: its affine is not finite: {affine[:3].tolist()}")
+    if oblique == "refuse":
+        try:
+            axis_aligned(affine[:3, :3].T, name)
+        except ValueError as error:
+            if "oblique" not in str(error):
+                raise
+            raise ValueError(f"{error}; or take the voxel axes as they are with "
+                             "oblique='voxel-axes' (--oblique voxel-axes)") from None
     ornt, spacing, origin = nifti_orientation(image)
     data = orientations.apply_orientation(data, ornt)
     data = np.ascontiguousarray(data.transpose(2, 1, 0))  # (i, j, k) -> [z, y, x]
@@ -232,10 +323,12 @@ def _frame(name, shape, frame):
 
 
 def load_nrrd(path, *, extent=None, nan="error"):
-    """Load an NRRD file (``.nrrd``, or ``.nhdr`` with its data file) through pynrrd.
+    """Load an NRRD file (``.nrrd``, or ``.nhdr`` with its data file in the same folder or
+    below it) with every size its header claims checked first
+    (:func:`data_gen.nrrd_files.read_nrrd`).
 
-    Spacing from ``space directions`` (their lengths) or ``spacings``; origin from
-    ``space origin``.
+    Spacing and orientation from ``space directions`` (flips and axis swaps applied, LPS and
+    LAS turned to RAS, oblique grids refused) or ``spacings``; origin from ``space origin``.
 
     Examples
     --------
@@ -246,26 +339,9 @@ def load_nrrd(path, *, extent=None, nan="error"):
     >>> vol.shape, vol.spacing.tolist()
     ((2, 3, 4), [0.5, 1.0, 2.0])
     """
-    import nrrd
+    from data_gen.nrrd_files import read_nrrd
 
-    path = _existing(path)
-    try:
-        data, header = nrrd.read(str(path), index_order="C")
-    except Exception as error:  # pynrrd raises NRRDError, ValueError, OSError and others
-        raise _unreadable(path, "NRRD", error) from None
-    if data.ndim != 3:
-        raise ValueError(f"{path.name} must hold a 3-D volume, got {data.ndim} dimension(s) "
-                         f"of shape {data.shape}")
-    spacing = None
-    if header.get("space directions") is not None:
-        directions = np.array([d for d in header["space directions"] if d is not None],
-                              dtype=np.float64)
-        if directions.shape == (3, 3) and np.all(np.isfinite(directions)):
-            spacing = np.linalg.norm(directions, axis=1)
-    elif header.get("spacings") is not None:
-        spacing = np.asarray(header["spacings"], dtype=np.float64)
-    origin = header.get("space origin")
-    origin = None if origin is None else np.asarray(origin, dtype=np.float64)
+    data, spacing, origin = read_nrrd(_existing(path))
     return _volume(data, extent, spacing, origin, nan)
 
 
@@ -289,23 +365,21 @@ def load_tiff(path, *, spacing=None, extent=None, nan="error"):
     import tifffile
 
     path = _existing(path)
-    quiet = logging.getLogger("tifffile")
-    level = quiet.level
-    quiet.setLevel(logging.CRITICAL)  # its warnings become this loader's one-line errors
     try:
-        with tifffile.TiffFile(path) as tif:
+        with _quiet("tifffile"), tifffile.TiffFile(path) as tif:
             if not tif.series or not len(tif.pages):
                 raise ValueError("it holds no images")
             series = tif.series[0]
+            check_allocation(math.prod(series.shape), series.dtype, path.name)
             found = _tiff_spacing(tif)
             try:
                 data = tifffile.memmap(path)
             except (ValueError, OSError):  # compressed or scattered pages: read them
                 data = series.asarray()
     except Exception as error:  # tifffile raises TiffFileError, ValueError and others
+        if str(error).startswith(f"{path.name}:"):
+            raise
         raise _unreadable(path, "TIFF", error) from None
-    finally:
-        quiet.setLevel(level)
     data = np.squeeze(data)
     if data.ndim != 3:
         raise ValueError(f"{path.name} must hold a 3-D stack of one channel, got shape "
@@ -350,11 +424,21 @@ def load_vtk(path, *, scalars=None, extent=None, nan="error"):
     """
     import pyvista
 
+    from pyvista.core.utilities.observers import VtkErrorCatcher
+
     path = _existing(path)
+    _check_vtk_claims(path)
     try:
-        grid = pyvista.read(path)
+        # VTK's complaints become this loader's one-line error, not log lines.
+        with _quiet("root"), pyvista.vtk_verbosity("off"), VtkErrorCatcher(
+                raise_errors=True, send_to_logging=False):
+            grid = pyvista.read(path)
     except Exception as error:  # VTK readers raise many kinds, or return an empty dataset
-        raise _unreadable(path, "VTK", error) from None
+        # VTK's own words, without its source file and object address.
+        lines = [re.sub(r"^\w+ \(0x[0-9a-f]+\): ", "", line.strip())
+                 for line in str(error).splitlines()
+                 if line.strip() and not line.startswith("ERROR: In ")]
+        raise _unreadable(path, "VTK", lines[0] if lines else error) from None
     if not isinstance(grid, pyvista.ImageData) or grid.n_points == 0:
         raise ValueError(f"{path.name} must hold VTK image data (a regular grid), got "
                          f"{type(grid).__name__} with {grid.n_points} points")
@@ -366,6 +450,11 @@ def load_vtk(path, *, scalars=None, extent=None, nan="error"):
                          f"{cells} (choose one with scalars=)")
     spacing = np.asarray(grid.spacing, dtype=np.float64)
     origin = np.asarray(grid.origin, dtype=np.float64)
+    if not (np.all(np.isfinite(spacing)) and np.all(spacing > 0) and
+            np.all(np.isfinite(origin))):
+        raise ValueError(f"{path.name}: its spacing {spacing.tolist()} and origin "
+                         f"{origin.tolist()} must be finite, the spacing positive")
+    direction = np.asarray(getattr(grid, "direction_matrix", np.eye(3)), dtype=np.float64)
     if name in points:
         nx, ny, nz = grid.dimensions
         values = np.asarray(grid.point_data[name])
@@ -376,7 +465,64 @@ def load_vtk(path, *, scalars=None, extent=None, nan="error"):
     if values.ndim != 1:
         raise ValueError(f"{path.name}: array {name!r} must hold one value per point or cell, got "
                          f"shape {values.shape}")
-    return _volume(values.reshape(nz, ny, nx), extent, spacing, origin, nan)
+    values = values.reshape(nz, ny, nx)
+    if not np.array_equal(direction, np.eye(3)):  # the grid's axes turned: apply it exactly
+        if name in cells:
+            origin = origin - spacing / 2 + direction @ (spacing / 2)
+        values, spacing, origin = to_world_axes(values, (direction * spacing).T, origin,
+                                                path.name)
+    return _volume(values, extent, spacing, origin, nan)
+
+
+_VTK_TYPES = {"bit": 1, "unsigned_char": 1, "char": 1, "short": 2, "unsigned_short": 2,
+              "int": 4, "unsigned_int": 4, "long": 8, "unsigned_long": 8, "float": 4,
+              "double": 8, "vtktypeint64": 8, "vtktypeuint64": 8}
+
+
+_VTK_SCALARS = re.compile(rb"SCALARS\s+\S+\s+(\w+)(\s+\d+)?\s*\n(LOOKUP_TABLE\s+\S+\s*\n)?")
+
+
+def _check_vtk_claims(path):
+    """Check what a VTK file's header claims before VTK reads it (VTK allocates what an
+    extent claims, and aborts the process when it cannot): the grid's size against the
+    memory, and a binary legacy file's samples against its length (VTK would fill the
+    missing ones with whatever memory held)."""
+    with open(path, "rb") as fh:
+        head = fh.read(1 << 16)
+    found = re.search(rb'WholeExtent="([^"]*)"', head)
+    if found is not None:
+        try:
+            extent = [int(v) for v in found.group(1).split()]
+        except ValueError:
+            extent = []
+        if len(extent) != 6 or any(b < a for a, b in zip(extent[::2], extent[1::2])):
+            raise ValueError(f"{path.name} is not a readable VTK file: WholeExtent "
+                             f"{found.group(1).decode('latin-1')!r}")
+        count = math.prod(b - a + 1 for a, b in zip(extent[::2], extent[1::2]))
+        check_allocation(count, np.float64, path.name)
+        return
+    dims = re.search(rb"\nDIMENSIONS\s+(-?\d+)\s+(-?\d+)\s+(-?\d+)", head)
+    if dims is None:
+        return  # not image data: VTK says what it is
+    shape = [int(v) for v in dims.groups()]
+    if min(shape) < 1:
+        raise ValueError(f"{path.name} is not a readable VTK file: DIMENSIONS {shape}")
+    check_allocation(math.prod(shape), np.float64, path.name)
+    if b"\nBINARY" not in head[:512].replace(b"\r", b""):
+        return
+    size = path.stat().st_size
+    for data in re.finditer(rb"\n(POINT_DATA|CELL_DATA)\s+(\d+)\s*\n", head):
+        count = int(data.group(2))
+        field = _VTK_SCALARS.search(head, data.end())
+        if field is None:
+            continue
+        kind = field.group(1).decode("latin-1").lower()
+        components = int(field.group(2) or 1)
+        needed = count * components * _VTK_TYPES.get(kind, 1)
+        if size - field.end() < needed:
+            raise ValueError(f"{path.name} holds {size - field.end()} bytes of {kind} "
+                             f"samples, but its header claims {needed} ({count} of them): "
+                             "truncated?")
 
 
 def load_dicom(folder, *, series=None, extent=None, nan="error"):
@@ -417,7 +563,10 @@ def load_dicom(folder, *, series=None, extent=None, nan="error"):
             continue
         slices.setdefault(str(ds.get("SeriesInstanceUID", "")), []).append((file, ds))
     if not slices:
-        raise ValueError(f"no DICOM slices with pixel data in {str(folder)!r}")
+        inner = sorted(p.name for p in folder.iterdir() if p.is_dir())
+        searched = (f" (sub-folders are not searched: name one of {inner[:5]}"
+                    f"{' ...' if len(inner) > 5 else ''})" if inner else "")
+        raise ValueError(f"no DICOM slices with pixel data in {str(folder)!r}{searched}")
     if series is None and len(slices) > 1:
         raise ValueError(f"{folder.name} holds {len(slices)} DICOM series: choose one with "
                          f"series= (one of {sorted(slices)})")
@@ -500,7 +649,9 @@ def load_den(path, *, extent=None, nan="error"):
     ((2, 3, 4), 23.0)
     """
     path = _existing(path)
-    raw = path.read_bytes()
+    length = path.stat().st_size
+    with open(path, "rb") as fh:
+        raw = fh.read(_DEN_HEADER)  # the header alone: the samples are mapped, not read
     if len(raw) < _DEN_HEADER:
         raise ValueError(f"{path.name} is not a .den file: {len(raw)} bytes, shorter than its "
                          f"{_DEN_HEADER}-byte header")
@@ -516,11 +667,12 @@ def load_den(path, *, extent=None, nan="error"):
     if np.any(lengths < 2) or size != math.prod(lengths.tolist()):
         raise ValueError(f"{path.name} is not a .den file: its header's map lengths "
                          f"{lengths.tolist()} and size {size} disagree")
-    if len(raw) != _DEN_HEADER + size:
-        raise ValueError(f"{path.name} holds {len(raw) - _DEN_HEADER} sample bytes, but its "
+    if length != _DEN_HEADER + size:
+        raise ValueError(f"{path.name} holds {length - _DEN_HEADER} sample bytes, but its "
                          f"header says {size} ({'x'.join(map(str, lengths))}): truncated?")
     nx, ny, nz = lengths.tolist()
-    data = np.frombuffer(raw, dtype=np.uint8, offset=_DEN_HEADER).reshape(nz, ny, nx)
+    check_allocation(size, np.uint8, path.name)
+    data = np.memmap(path, dtype=np.uint8, mode="r", offset=_DEN_HEADER, shape=(nz, ny, nx))
     return _volume(data, extent, None, None, nan)
 
 
@@ -565,7 +717,12 @@ def load(source, **options):
             if ending == ".raw" and not {"shape", "dtype"} <= set(options):
                 raise ValueError("a .raw file needs shape=(nz, ny, nx) and dtype= (on the "
                                  "command line --shape NZ,NY,NX --dtype TYPE)")
-            return loader(path, **options)
+            try:
+                return loader(path, **options)
+            except ValueError as error:  # the volume's own checks: name the file too
+                if path.name in str(error):
+                    raise
+                raise ValueError(f"{path.name}: {error}") from None
     if not path.exists():
         raise FileNotFoundError(f"no volume file or folder at {str(source)!r}")
     endings = ", ".join(FORMATS)

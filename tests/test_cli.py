@@ -111,7 +111,10 @@ def test_render_reads_files(tmp_path):
     (["render", "frog", "--opacity", "0:0;1", "-o", "x.png"], "opacity points must be"),
     (["render", "frog", "--opacity", "0:0,1:2", "-o", "x.png"], "alpha must lie in [0, 1]"),
     (["render", "frog", "--cmap", "nosuchmap", "-o", "x.png"], "unknown colormap"),
-    (["render", "frog", "--clim", "0,1", "-o", "x.png"], "--clim applies with --opacity"),
+    (["render", "frog", "--clim", "0,1", "--transfer", "glow:1", "-o", "x.png"],
+     "not both"),
+    (["render", "gaussian-blob:9", "--step", "1e-9", "-o", "x.png"], "step must be at least"),
+    (["render", "gaussian-blob:9", "--size", "-o", "x.png"], "(see vrlib render --help)"),
     (["render", "frog", "--frame", "1", "-o", "x.png"], "--frame applies to .nii"),
     (["render", "gaussian-blob:8", "-o", "missing/x.png"], "no folder 'missing' for the output"),
     (["render", "gaussian-blob:8", "-o", "/etc/hostname/x.png"], "is a file"),
@@ -151,7 +154,7 @@ def test_bad_files_exit_2_with_one_line(tmp_path):
             (["short.raw", "--shape", "4,4,5", "--dtype", "uint8"], "raw file holds 64 bytes"),
             (["bad.nii"], "not a readable NIfTI file"),
             (["bad.tif"], "not a readable TIFF file"),
-            (["v.xyz"], "unknown volume"),
+            (["v.xyz"], "vrlib does not read .xyz files; it reads .npy"),
             (["v.npy", "--offset", "8"], "--offset applies to .raw files only")):
         args[0] = str(inputs / args[0])
         done = run("render", *args, "-o", "x.png", cwd=out)
@@ -238,8 +241,30 @@ def test_version():
 
 
 def test_argparse_errors_exit_2():
+    """In one line, as the command's own errors, not argparse's usage block."""
     done = run("render", "marschner-lobb:17")  # no -o
-    assert done.returncode == 2 and "-o/--output" in done.stderr
+    lines = done.stderr.strip().splitlines()
+    assert done.returncode == 2 and len(lines) == 1 and "-o/--output" in lines[0]
+    assert lines[0].startswith("vrlib: error: ")
+
+
+def test_a_ct_window_alone_with_negative_limits(tmp_path):
+    """``--clim -1000,400`` (without ``=``) is a window; with no --opacity it ramps the
+    opacity over the window."""
+    data = np.linspace(-1200.0, 600.0, 9**3).reshape(9, 9, 9)
+    np.save(tmp_path / "ct.npy", data)
+    done = run("render", str(tmp_path / "ct.npy"), "--clim", "-1000,400", "--size", "16",
+               "-o", str(tmp_path / "ct-image.npy"))
+    assert done.returncode == 0, done.stderr
+    alpha = np.load(tmp_path / "ct-image.npy")[..., 3]
+    assert 0.0 < alpha.max() < 1.0
+
+
+def test_a_file_name_with_a_line_break_stays_one_line(tmp_path):
+    (tmp_path / "bad\nname.nii").write_bytes(b"\x5c\x01" + bytes(300))
+    done = run("info", str(tmp_path / "bad\nname.nii"))
+    lines = done.stderr.strip().splitlines()
+    assert done.returncode == 2 and len(lines) == 1 and "bad\\nname.nii" in lines[0], lines
 
 
 def test_help_shows_examples():

@@ -198,8 +198,8 @@ def test_a_volume_in_its_own_units_renders_framed():
 
 @pytest.mark.parametrize("name, content, message", [
     ("v.nii", b"\x5c\x01" + bytes(100), "not a readable NIfTI file"),
-    ("v.nrrd", b"NRRD0004\ntype: short\ndimension: 3\nsizes: 4 4 4\nencoding: raw\n\n"
-     + bytes(10), "not a readable NRRD file"),
+    ("v.nrrd", b"NRRD0004\ntype: short\ndimension: 3\nsizes: 4 4 4\nencoding: raw\n"
+     b"endian: little\n\n" + bytes(10), "holds 10 sample bytes, but its header claims 128"),
     ("v.tif", b"II*\x00" + bytes(4), "not a readable TIFF file"),
     ("v.vti", b"<VTKFile type='ImageData'>", "VTK"),
     ("v.den", bytes(30), "shorter than its 62-byte header"),

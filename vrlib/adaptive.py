@@ -37,6 +37,7 @@ import numpy as np
 from vrlib._kernels.filters import TENT
 from vrlib.transfer import range_maximum
 from vrlib.value_bounds import value_bounds
+from vrlib.volume import block_extremes
 
 __all__ = ["MAX_MULTIPLIER", "BlockDifferences", "block_differences", "derivative_sums",
            "gradient_bounds", "transfer_slopes", "step_multipliers"]
@@ -92,18 +93,9 @@ def _block_max(arr, block, margin, shape, front=0):
     last sample are 0, the border extends; ``front`` of them before the first, so that a
     second difference sits at its middle sample) over each block of ``block`` cells (both
     end samples) widened by ``margin`` samples each side."""
-    from scipy import ndimage
-
-    from vrlib.volume import _block_reduce_1d
-
     widths = [(0, n - m) for n, m in zip(shape, arr.shape)]
     widths = [(front, w[1] - front) if w[1] else w for w in widths]
-    arr = np.pad(arr, widths)
-    if margin:
-        arr = ndimage.maximum_filter(arr, size=2 * margin + 1, mode="nearest")
-    for axis in range(3):
-        arr = _block_reduce_1d(arr, axis, block, np.max)
-    return arr
+    return block_extremes(np.pad(arr, widths), block, np.max, margin=margin)
 
 
 def block_differences(volume, *, block=8, margin=0):

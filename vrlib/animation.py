@@ -16,6 +16,10 @@ from vrlib.view import View
 __all__ = ["turntable"]
 
 
+#: The most views a turntable takes (a view every 0.1 degree); its frames are kept in memory.
+MAX_FRAMES = 3600
+
+
 def turntable(volume, path, *, frames=36, elevation=20.0, size=256, zoom=1.0, fps=12,
               progress=True, **options):
     """Render ``frames`` views around the world z axis and write them to ``path``.
@@ -27,7 +31,7 @@ def turntable(volume, path, *, frames=36, elevation=20.0, size=256, zoom=1.0, fp
         ``.gif`` (Pillow) or ``.mp4`` (needs the ``imageio-ffmpeg`` package); written under a
         temporary name and renamed when complete.
     frames : int, default 36
-        Views at azimuths ``360 i / frames`` degrees (>= 1).
+        Views at azimuths ``360 i / frames`` degrees (1 to :data:`MAX_FRAMES`).
     elevation : float, default 20
         Degrees above the xy plane.
     size, zoom
@@ -60,6 +64,9 @@ def turntable(volume, path, *, frames=36, elevation=20.0, size=256, zoom=1.0, fp
     suffix = path.suffix.lower()
     validate.choice("path suffix", suffix, (".gif", ".mp4"))
     frames = validate.positive_int("frames", frames)
+    if frames > MAX_FRAMES:
+        raise ValueError(f"frames must be at most {MAX_FRAMES} (a view every 0.1 degree), "
+                         f"got {frames}")
     fps = validate.positive_number("fps", fps)
     if suffix == ".mp4":
         try:

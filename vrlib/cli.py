@@ -7,6 +7,7 @@ Bad input ends with exit status 2 and a one-line message naming what was wrong.
 from __future__ import annotations
 
 import argparse
+import os
 import platform
 import sys
 import tempfile
@@ -50,11 +51,15 @@ class UsageError(Exception):
     """Bad input from the command line: reported in one line, exit status 2."""
 
 
-def check_output(path, suffixes):
+def check_output(path, suffixes, *, source=None):
     """Refuse an output the command could not write, before any work is done: a wrong
     suffix, a missing folder (not created silently), a folder that is a file or not writable,
-    or a path that is a folder."""
+    a path that is a folder, or the input ``source`` itself (it would be overwritten)."""
     path = Path(path)
+    if source is not None and path.exists() and Path(source).exists() and \
+            os.path.samefile(path, source):
+        raise UsageError(f"output {str(path)!r} is the input volume: it would be overwritten; "
+                         "write the image to another file")
     if path.suffix.lower() not in suffixes:
         raise UsageError(f"output must end in {' or '.join(suffixes)}, got {str(path)!r}")
     folder = path.parent
@@ -73,17 +78,6 @@ def check_output(path, suffixes):
     return path
 
 
-def _available_bytes():
-    """Memory available to new allocations (Linux's MemAvailable), or None if unknown."""
-    try:
-        for line in Path("/proc/meminfo").read_text().splitlines():
-            if line.startswith("MemAvailable:"):
-                return int(line.split()[1]) * 1024
-    except OSError:
-        pass
-    return None
-
-
 def _number(text):
     try:
         value = float(text)
@@ -93,9 +87,10 @@ def _number(text):
 
 
 def load_volume(spec, *, shape=None, dtype=None, offset=0, frame=None, series=None,
-                scalars=None, nan="error"):
+                scalars=None, nan="error", oblique="refuse", spacing=None):
     """``(volume, field or None)`` from a command-line volume spec."""
     import data_gen
+    from data_gen.untrusted import available_bytes
 
     path = Path(spec)
     name = path.name.lower()
@@ -108,8 +103,16 @@ def load_volume(spec, *, shape=None, dtype=None, offset=0, frame=None, series=No
             if shape is None or dtype is None:
                 raise UsageError("a .raw volume needs --shape NZ,NY,NX and --dtype")
             options = {"shape": shape, "dtype": dtype, "offset": offset}
-        elif offset:
-            raise UsageError("--offset applies to .raw files only")
+        elif offset or shape is not None or dtype is not None:
+            given = [flag for flag, value in (("--offset", offset), ("--shape", shape),
+                                              ("--dtype", dtype)) if value]
+            raise UsageError(f"{', '.join(given)} appl{'ies' if len(given) == 1 else 'y'} "
+                             f"to .raw files only, not {path.name}")
+        if spacing is not None:
+            if not name.endswith((".npy", ".raw", ".tif", ".tiff")):
+                raise UsageError("--spacing applies to .npy, .raw and TIFF files only (the "
+                                 "others carry their own)")
+            options["spacing"] = _triple(spacing, "--spacing")
         for key, value, ending in (("frame", frame, (".nii", ".nii.gz")),
                                    ("scalars", scalars, (".vti", ".vtk"))):
             if value is not None:
@@ -118,11 +121,20 @@ def load_volume(spec, *, shape=None, dtype=None, offset=0, frame=None, series=No
                 options[key] = value
         if nan != "error":
             options["nan"] = nan
+        if oblique != "refuse":
+            if not name.endswith((".nii", ".nii.gz")):
+                raise UsageError("--oblique applies to .nii and .nii.gz files only")
+            options["oblique"] = oblique
         if series is not None:
             if not path.is_dir():
                 raise UsageError("--series applies to a folder of DICOM slices only")
             options["series"] = series
         return data_gen.load(spec, **options), None
+    if path.is_file():
+        endings = ", ".join(data_gen.FORMATS)
+        raise UsageError(f"{spec}: vrlib does not read {path.suffix or 'extension-less'!s} "
+                         f"files; it reads {endings}, and a DICOM series as a folder of "
+                         "slice files")
     field_name, *rest = spec.split(":")
     if field_name not in data_gen.FIELDS:
         known = ", ".join(data_gen.FIELDS)
@@ -143,7 +155,7 @@ def load_volume(spec, *, shape=None, dtype=None, offset=0, frame=None, series=No
     field = data_gen.make_field(field_name, **params)
     if samples < 2:
         raise UsageError(f"samples per axis must be at least 2, got {samples}")
-    needed, available = 8 * samples**3, _available_bytes()
+    needed, available = 8 * samples**3, available_bytes()
     # Sampling peaks at about 2.6 times the samples (measured at 200^3), and rendering
     # derives more from them: ask for 4 times the samples' size.
     if available is not None and 4 * needed > available:
@@ -155,6 +167,16 @@ def load_volume(spec, *, shape=None, dtype=None, offset=0, frame=None, series=No
     return field.sample(samples), field
 
 
+def _triple(text, what):
+    try:
+        values = tuple(float(v) for v in text.split(","))
+    except ValueError:
+        values = ()
+    if len(values) != 3:
+        raise UsageError(f"{what} must be X,Y,Z (three numbers), got {text!r}")
+    return values
+
+
 def _pair(text, what):
     try:
         low, high = (float(v) for v in text.split(","))
@@ -163,32 +185,38 @@ def _pair(text, what):
     return low, high
 
 
+#: Opacity per voxel at the top of a window given alone (``--clim``), as the automatic ramp's.
+AUTO_PEAK_ALPHA = 0.25
+
+
 def make_transfer(args, field):
     """The transfer function the arguments ask for, as a function of the volume."""
     import vrlib
 
     shading = vrlib.Phong() if args.shade else None
+    if args.cmap is not None and not args.cmap.strip():
+        raise UsageError("--cmap needs a colormap name (bone, viridis, gray, ...)")
     if args.labels:
         if args.transfer is not None or args.opacity is not None or args.clim is not None:
             raise UsageError("--labels gives every label its own colour: it takes --cmap and "
                              "--shade, not --transfer, --opacity or --clim")
         return lambda volume: vrlib.label_transfer(volume, cmap=args.cmap or "tab20",
                                                    shading=shading)
-    if args.cmap is not None or args.opacity is not None:
+    if args.cmap is not None or args.opacity is not None or args.clim is not None:
         if args.transfer is not None:
-            raise UsageError("give either --transfer or --cmap/--opacity, not both")
+            raise UsageError("give either --transfer or --cmap/--opacity/--clim, not both")
         cmap = args.cmap or "gray"
         clim = None if args.clim is None else _pair(args.clim, "--clim")
         if args.opacity is None:
-            if clim is not None:
-                raise UsageError("--clim needs --opacity (the automatic ramp finds its own "
-                                 "limits)")
-            return lambda volume: vrlib.auto_transfer(volume, cmap, shading=shading)
-        points = vrlib.colormapping.parse_opacity(args.opacity)
+            if clim is None:
+                return lambda volume: vrlib.auto_transfer(volume, cmap, shading=shading)
+            # A window alone: colour over it, opacity ramping from 0 at its low end to the
+            # automatic ramp's peak at its high end.
+            points = [(0.0, 0.0), (1.0, AUTO_PEAK_ALPHA)]
+        else:
+            points = vrlib.colormapping.parse_opacity(args.opacity)
         return lambda volume: vrlib.colormap(cmap, points, clim=clim, volume=volume,
                                              shading=shading)
-    if args.clim is not None:
-        raise UsageError("--clim applies with --opacity")
     spec = args.transfer or ("glow:1" if field is not None else "auto")
     kind, *numbers = spec.split(":")
     if kind == "auto" and not numbers:
@@ -253,6 +281,11 @@ def _add_volume(parser, optional=False):
     parser.add_argument("--nan", default="error", choices=["error", "transparent"],
                         help="NaN samples in a file: refuse them (default), or holes that "
                              "contribute nothing")
+    parser.add_argument("--spacing", help="X,Y,Z voxel size of a .npy, .raw or TIFF file "
+                                          "(default the TIFF's own, else 1)")
+    parser.add_argument("--oblique", default="refuse", choices=["refuse", "voxel-axes"],
+                        help="a NIfTI scan on an oblique grid: refuse it (default), or show it "
+                             "in its own voxel axes, the rotation left out")
 
 
 def _add_scene(parser):
@@ -296,18 +329,26 @@ def _filter(args):
 def _load(args):
     return load_volume(args.volume, shape=args.shape, dtype=args.dtype, offset=args.offset,
                        frame=args.frame, series=args.series, scalars=args.scalars,
-                       nan=args.nan)
+                       nan=args.nan, oblique=args.oblique, spacing=args.spacing)
 
 
 def cmd_render(args):
     import vrlib
     from vrlib.cost import measure
 
-    check_output(args.output, (".png", ".npy"))
+    check_output(args.output, (".png", ".npy"), source=args.volume)
     volume, field = _load(args)
     view = make_view(args, volume)
     transfer = make_transfer(args, field)(volume)
+    method, blend, options = _method_options(args)
     if args.classified:
+        given = [flag for flag, value in (("--method", args.method), ("--blend", args.blend),
+                                          ("--filter", args.filter), ("--step", args.step),
+                                          ("--tolerance", args.tolerance),
+                                          ("--option", args.option)) if value]
+        if given:
+            raise UsageError(f"--classified renders by shear-warp, emission-absorption, as "
+                             f"VolPack does: leave out {', '.join(given)}")
         if view.is_perspective:
             raise UsageError("--classified renders orthographic views only (as VolPack)")
         scene = vrlib.classify(volume, transfer)
@@ -316,13 +357,16 @@ def cmd_render(args):
     elif args.tolerance is not None:
         if args.step is not None:
             raise UsageError("--tolerance chooses the step itself: leave out --step")
-        if args.blend != "emission-absorption":
+        if blend != "emission-absorption":
             raise UsageError("--tolerance is kept for --blend emission-absorption only")
-        if args.method not in ("raycast", "auto"):
+        if method not in ("raycast", "auto"):
             raise UsageError(f"--tolerance is kept by ray casting only: use --method raycast "
-                             f"or --method auto (not {args.method})")
+                             f"or --method auto (not {method})")
+        if options:
+            raise UsageError("--tolerance chooses the method's options itself: leave out "
+                             "--option")
         seconds, img = measure(partial(
-            vrlib.render, volume, view, method=args.method, filter=_filter(args),
+            vrlib.render, volume, view, method=method, filter=_filter(args),
             transfer=transfer, tolerance=args.tolerance), repeats=1, warmup=False)
         chosen = img.stats.choices
         what = (f"{chosen['method']}/{_filter(args)} to rmse {args.tolerance:g} (step "
@@ -331,11 +375,11 @@ def cmd_render(args):
     else:
         step = 0.5 if args.step is None else args.step
         seconds, img = measure(partial(
-            vrlib.render, volume, view, method=args.method, filter=_filter(args),
-            transfer=transfer, step=step, blend=args.blend), repeats=1, warmup=False)
-        what = f"{args.method}/{_filter(args)}"
-        if args.blend != "emission-absorption":
-            what += f", {args.blend} intensity projection"
+            vrlib.render, volume, view, method=method, filter=_filter(args),
+            transfer=transfer, step=step, blend=blend, **options), repeats=1, warmup=False)
+        what = f"{method}/{_filter(args)}"
+        if blend != "emission-absorption":
+            what += f", {blend} intensity projection"
     img.save(args.output, bits=args.bits)
     print(f"{args.output}: {view.width}x{view.height} {what} in {seconds:.3f} s")
 
@@ -343,13 +387,14 @@ def cmd_render(args):
 def cmd_turntable(args):
     import vrlib
 
-    check_output(args.output, (".gif", ".mp4"))
+    check_output(args.output, (".gif", ".mp4"), source=args.volume)
     volume, field = _load(args)
     transfer = make_transfer(args, field)(volume)
+    method, blend, options = _method_options(args)
     images = vrlib.turntable(volume, args.output, frames=args.frames, elevation=args.elevation,
-                             size=args.size, zoom=args.zoom, fps=args.fps, method=args.method,
-                             filter=_filter(args), transfer=transfer,
-                             step=0.5 if args.step is None else args.step)
+                             size=args.size, zoom=args.zoom, fps=args.fps, method=method,
+                             filter=_filter(args), transfer=transfer, blend=blend,
+                             step=0.5 if args.step is None else args.step, **options)
     seconds = sum(image.stats.seconds for image in images)
     print(f"{args.output}: {len(images)} frames of {args.size}x{args.size}, rendered in "
           f"{seconds:.2f} s")
@@ -462,7 +507,7 @@ def describe_volume(volume):
     data = vrlib.colormapping.finite_values(volume)
     low, high = volume.value_range
     ext = " x ".join(f"[{a:g}, {b:g}]" for a, b in volume.extent)
-    lines = [f"shape (z, y, x): {volume.shape}, stored as {volume.dtype}",
+    lines = [f"shape (z, y, x): {volume.shape}, held in memory as {volume.dtype}",
              f"spacing (x, y, z): {', '.join(f'{v:g}' for v in volume.spacing)}",
              f"world box: {ext}",
              f"values: {low:g} .. {high:g}"]
@@ -490,9 +535,20 @@ def cmd_info(args):
     import vrlib
 
     if args.volume is not None:
-        volume, field = _load(args)
+        first = []
+        try:
+            volume, field = _load(args)
+        except ValueError as error:  # a 4-D file: describe its first frame
+            if not str(error).startswith("frame:") or args.frame is not None:
+                raise
+            import nibabel
+
+            frames = int(nibabel.load(args.volume).shape[3])
+            args.frame = 0
+            volume, field = _load(args)
+            first = [f"4-D: {frames} frames; frame 0 below (choose one with --frame)"]
         what = f"analytic field {field!r}, sampled" if field is not None else args.volume
-        print("\n".join([what] + describe_volume(volume)))
+        print("\n".join([what] + first + describe_volume(volume)))
         return
 
     lines = [f"vrlib {vrlib.__version__}",
@@ -526,8 +582,58 @@ def _version():
         return "(not installed)"
 
 
+class _Parser(argparse.ArgumentParser):
+    """argparse, its errors in one line as the command's own (not nine lines of usage)."""
+
+    def error(self, message):
+        self.exit(2, f"vrlib: error: {message} (see {self.prog} --help)\n")
+
+
+#: Options whose values may start with a minus sign (CT windows: --clim -1000,400).
+_SIGNED_VALUES = ("--clim",)
+
+
+def _signed_values(argv):
+    """``argv`` with ``--clim -1000,400`` joined into ``--clim=-1000,400`` (argparse would
+    take the value for an option)."""
+    out, i = [], 0
+    while i < len(argv):
+        if argv[i] in _SIGNED_VALUES and i + 1 < len(argv) and argv[i + 1].startswith("-") \
+                and argv[i + 1][1:2].isdigit():
+            out.append(f"{argv[i]}={argv[i + 1]}")
+            i += 2
+        else:
+            out.append(argv[i])
+            i += 1
+    return out
+
+
+def _add_method(parser):
+    parser.add_argument("--method", default=None,
+                        help="raycast, splat, shear3, shear2, shearwarp or auto (default "
+                             "raycast)")
+    parser.add_argument("--blend", default=None,
+                        choices=["emission-absorption", "maximum", "average"],
+                        help="composite the samples (default), or project the largest "
+                             "(maximum intensity) or mean value along each ray (ray casting)")
+    parser.add_argument("--option", action="append", default=[], metavar="NAME=VALUE",
+                        help="a method's own option, e.g. --option mode=direct (splat), "
+                             "--option segment_ends=exact (raycast); repeat for more")
+
+
+def _method_options(args):
+    """``(method, blend, options)`` from --method, --blend and --option."""
+    options = {}
+    for text in args.option:
+        name, equals, value = text.partition("=")
+        if not equals or not name.strip():
+            raise UsageError(f"--option must be NAME=VALUE, got {text!r}")
+        options[name.strip().replace("-", "_")] = _number(value.strip())
+    return (args.method or "raycast", args.blend or "emission-absorption", options)
+
+
 def parser():
-    top = argparse.ArgumentParser(
+    top = _Parser(
         prog="vrlib", description="Render volumes and compare renderers (vrlib).",
         epilog=EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
     top.add_argument("--version", action="version", version=f"vrlib {_version()}")
@@ -535,13 +641,7 @@ def parser():
     render = sub.add_parser("render", help="render a volume to an image",
                             epilog=EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
     _add_scene(render)
-    render.add_argument("--method", default="raycast",
-                        help="raycast, splat, shear3, shear2, shearwarp or auto (default "
-                             "raycast)")
-    render.add_argument("--blend", default="emission-absorption",
-                        choices=["emission-absorption", "maximum", "average"],
-                        help="composite the samples (default), or project the largest "
-                             "(maximum intensity) or mean value along each ray (ray casting)")
+    _add_method(render)
     render.add_argument("--classified", action="store_true",
                         help="classify once and render by shear-warp as VolPack does (takes "
                              "--shade; --method, --filter and --step do not apply)")
@@ -555,9 +655,7 @@ def parser():
     spin = sub.add_parser("turntable", help="views around the volume as a .gif or .mp4",
                           epilog=EXAMPLES, formatter_class=argparse.RawDescriptionHelpFormatter)
     _add_scene(spin)
-    spin.add_argument("--method", default="raycast",
-                      help="raycast, splat, shear3, shear2, shearwarp or auto (default "
-                           "raycast)")
+    _add_method(spin)
     spin.add_argument("--frames", type=int, default=36, help="views around the turntable")
     spin.add_argument("--fps", type=float, default=12.0, help="frames per second")
     spin.add_argument("-o", "--output", required=True, help="output .gif or .mp4")
@@ -581,6 +679,44 @@ def parser():
     return top
 
 
+def _one_line(text, source):
+    """The message's first line in the command line's terms: a file name with line breaks
+    in it escaped, Python's keywords (``nan='transparent'``, ``series=``) named by their
+    flags (:func:`_as_flags`)."""
+    if source and any(c in str(source) for c in "\r\n"):
+        for name in (str(source), Path(source).name):
+            text = text.replace(name, ascii(name)[1:-1])
+    return _as_flags(text.splitlines()[0]) if text else ""
+
+
+def _as_flags(text):
+    """``text`` with each ``name='value'`` or ``name=value`` (and a bare ``name=``) of a
+    keyword the command line has a flag for written as that flag, and a method's own option
+    as ``--option name=value``.
+
+    Examples
+    --------
+    >>> _as_flags("use nan='transparent', mode='sheet' or method='raycast'; frame=0..3")
+    'use --nan transparent, --option mode=sheet or --method raycast; --frame 0..3'
+    """
+    import re
+
+    from vrlib.render import METHODS, method_options
+
+    flags = {"nan", "series", "frame", "scalars", "oblique", "filter", "method", "blend",
+             "step", "transfer", "tolerance", "spacing", "shape", "dtype", "offset"}
+    own = {name for method in METHODS for name in method_options(method)}
+
+    def flag(match):
+        name, value = match.group(1), match.group(2) or match.group(3) or ""
+        if name in flags:
+            return f"--{name} {value}".rstrip()
+        return f"--option {name}={value}"
+
+    names = "|".join(sorted(flags | own, key=len, reverse=True))
+    return re.sub(rf"(?<![\w-])({names})=(?:'([^']*)'|([^\s,;)]*))", flag, text)
+
+
 def main(argv=None):
     """Run the command line; returns the exit status (2 on bad input).
 
@@ -589,7 +725,8 @@ def main(argv=None):
     >>> main(["render", "no-such-volume", "-o", "x.png"])   # the message goes to stderr
     2
     """
-    args = parser().parse_args(argv)
+    argv = sys.argv[1:] if argv is None else list(argv)
+    args = parser().parse_args(_signed_values(argv))
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", EmptyImageWarning)
@@ -598,8 +735,14 @@ def main(argv=None):
         if isinstance(error, OSError) and error.strerror:  # without the "[Errno n]"
             message = f"{error.strerror}: {error.filename}" if error.filename else error.strerror
         else:
-            message = str(error).splitlines()[0] if str(error) else type(error).__name__
+            message = _one_line(str(error), getattr(args, "volume", None)) or \
+                type(error).__name__
         print(f"vrlib: error: {message}", file=sys.stderr)
+        return 2
+    except MemoryError:
+        source = getattr(args, "volume", None)
+        print(f"vrlib: error: out of memory{f' with {source}' if source else ''}: try a "
+              "smaller volume or image", file=sys.stderr)
         return 2
     for warning in caught:  # one line each, as the errors
         if issubclass(warning.category, EmptyImageWarning):

@@ -15,8 +15,12 @@ from scipy import ndimage
 from vrlib import validate
 from vrlib.holes import hole_value
 
-__all__ = ["Volume", "MinMaxPyramid", "DEFAULT_EXTENT", "check_extent", "fitted_extent",
-           "lattice_extent", "storage_dtype"]
+__all__ = ["Volume", "MinMaxPyramid", "DEFAULT_EXTENT", "MAX_MAGNITUDE", "check_extent",
+           "fitted_extent", "block_extremes", "lattice_extent", "storage_dtype"]
+
+#: The largest sample magnitude a volume takes: beyond it, differences of values (gradients,
+#: histograms, classification tables) overflow float64.
+MAX_MAGNITUDE = 1e300
 
 #: The default world box, ``[[xmin, xmax], [ymin, ymax], [zmin, zmax]]``: the cube [-1, 1]^3.
 DEFAULT_EXTENT = ((-1.0, 1.0), (-1.0, 1.0), (-1.0, 1.0))
@@ -177,6 +181,11 @@ class Volume:
             arr[holes] = hole_value(*self._range)
             holes.flags.writeable = False
             self._holes = holes
+        low, high = self._range or (float(arr.min()), float(arr.max()))
+        if max(abs(low), abs(high)) > MAX_MAGNITUDE:
+            raise ValueError(f"volume values reach {max(abs(low), abs(high)):.3g}, beyond "
+                             f"{MAX_MAGNITUDE:g}: their differences overflow; rescale them")
+        self._range = (low, high)
         if arr.base is not None or not copy:
             arr = arr.view()
         arr.flags.writeable = False
@@ -542,19 +551,31 @@ def _merge_2x2x2(arr, reduce):
     return arr
 
 
+def block_extremes(arr, block, reduce, *, margin=0):
+    """``reduce`` (``np.min`` or ``np.max``) of ``arr`` over each block of ``block`` cells
+    per axis (both end samples), each block widened by ``margin`` samples each side: the
+    finest level of a min-max pyramid (:meth:`Volume.minmax_pyramid`).
+
+    Examples
+    --------
+    >>> arr = np.zeros((9, 9, 9)); arr[8, 8, 8] = 1.0
+    >>> block_extremes(arr, 4, np.max)[:, 1, 1].tolist()
+    [0.0, 1.0]
+    """
+    window = {np.min: ndimage.minimum_filter, np.max: ndimage.maximum_filter}[reduce]
+    if margin:
+        # Widen every sample's reach by `margin` before the block reduction (separable).
+        arr = window(arr, size=2 * margin + 1, mode="nearest")
+    for axis in range(3):
+        arr = _block_reduce_1d(arr, axis, block, reduce)
+    return arr
+
+
 def _build_pyramid(data, block, margin):
     levels = {}
-    for name, reduce, window in (
-        ("minimum", np.min, ndimage.minimum_filter),
-        ("maximum", np.max, ndimage.maximum_filter),
-    ):
-        arr = data  # min and max are exact in the storage type
-        if margin:
-            # Widen every sample's reach by `margin` before the block reduction (separable).
-            arr = window(arr, size=2 * margin + 1, mode="nearest")
-        for axis in range(3):
-            arr = _block_reduce_1d(arr, axis, block, reduce)
-        stack = [arr]
+    for name, reduce in (("minimum", np.min), ("maximum", np.max)):
+        # min and max are exact in the storage type
+        stack = [block_extremes(data, block, reduce, margin=margin)]
         while max(stack[-1].shape) > 1:
             stack.append(_merge_2x2x2(stack[-1], reduce))
         levels[name] = stack
