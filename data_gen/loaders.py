@@ -96,11 +96,15 @@ def load_npy(path, *, spacing=None, origin=None, extent=None, nan="error"):
     ((2, 3, 4), [[0.0, 3.0], [0.0, 2.0], [0.0, 1.0]])
     """
     path = _existing(path)
+    with open(path, "rb") as fh:
+        magic = fh.read(6)
+    if magic != b"\x93NUMPY":
+        raise _unreadable(path, ".npy", "it does not start with the .npy signature")
     try:
         data = np.load(path, mmap_mode="r", allow_pickle=False)
     except (ValueError, OSError, EOFError) as error:
         text = str(error)
-        if "allow_pickle" in text or "pickle" in text.lower():
+        if "pickle" in text.lower():
             text = "it holds Python objects, not a numeric array"
         raise _unreadable(path, ".npy", text) from None
     if not isinstance(data, np.ndarray) or data.dtype.kind not in "biuf":
@@ -462,9 +466,9 @@ def load_vtk(path, *, scalars=None, extent=None, nan="error"):
         nx, ny, nz = (n - 1 for n in grid.dimensions)
         values = np.asarray(grid.cell_data[name])
         origin = origin + spacing / 2
-    if values.ndim != 1:
-        raise ValueError(f"{path.name}: array {name!r} must hold one value per point or cell, got "
-                         f"shape {values.shape}")
+    if values.ndim != 1 or values.size != nx * ny * nz:
+        raise ValueError(f"{path.name}: array {name!r} must hold one value per point or cell "
+                         f"({nx}x{ny}x{nz}), got shape {values.shape}")
     values = values.reshape(nz, ny, nx)
     if not np.array_equal(direction, np.eye(3)):  # the grid's axes turned: apply it exactly
         if name in cells:
@@ -480,6 +484,23 @@ _VTK_TYPES = {"bit": 1, "unsigned_char": 1, "char": 1, "short": 2, "unsigned_sho
 
 
 _VTK_SCALARS = re.compile(rb"SCALARS\s+\S+\s+(\w+)(\s+\d+)?\s*\n(LOOKUP_TABLE\s+\S+\s*\n)?")
+
+
+def _check_numbers(path, name, size, found):
+    """Refuse a VTK header's ``name`` (if ``found``) unless it is ``size`` finite numbers
+    (with a positive spacing)."""
+    if found is None:
+        return
+    text = found.group(1).decode("latin-1")
+    try:
+        values = [float(v) for v in text.split()]
+    except ValueError:
+        values = []
+    spacing = name in (b"Spacing", b"SPACING", b"ASPECT_RATIO")
+    if len(values) != size or not all(math.isfinite(v) and (v > 0 or not spacing)
+                                       for v in values):
+        raise ValueError(f"{path.name}: its {name.decode()} {text.strip()!r} must be {size} "
+                         f"finite numbers{', all positive' if spacing else ''}")
 
 
 def _check_vtk_claims(path):
@@ -500,6 +521,9 @@ def _check_vtk_claims(path):
                              f"{found.group(1).decode('latin-1')!r}")
         count = math.prod(b - a + 1 for a, b in zip(extent[::2], extent[1::2]))
         check_allocation(count, np.float64, path.name)
+        # VTK reads a spacing or origin it cannot parse ("nan", "inf") as 1 or 0.
+        for name, size in ((b"Spacing", 3), (b"Origin", 3), (b"Direction", 9)):
+            _check_numbers(path, name, size, re.search(rb'\s' + name + rb'="([^"]*)"', head))
         return
     dims = re.search(rb"\nDIMENSIONS\s+(-?\d+)\s+(-?\d+)\s+(-?\d+)", head)
     if dims is None:
@@ -508,6 +532,8 @@ def _check_vtk_claims(path):
     if min(shape) < 1:
         raise ValueError(f"{path.name} is not a readable VTK file: DIMENSIONS {shape}")
     check_allocation(math.prod(shape), np.float64, path.name)
+    for name in (b"SPACING", b"ASPECT_RATIO", b"ORIGIN"):
+        _check_numbers(path, name, 3, re.search(rb"\n" + name + rb"\s+([^\n]*)", head))
     if b"\nBINARY" not in head[:512].replace(b"\r", b""):
         return
     size = path.stat().st_size

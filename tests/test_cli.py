@@ -206,7 +206,7 @@ def test_nan_samples_refused_or_holes(tmp_path):
     data[2:4, 2:4, 2:4] = np.nan
     np.save(tmp_path / "nan.npy", data)
     done = run("render", str(tmp_path / "nan.npy"), "-o", str(tmp_path / "x.png"))
-    assert done.returncode == 2 and "nan='transparent'" in done.stderr
+    assert done.returncode == 2 and "--nan transparent" in done.stderr  # its own flag
     done = run("render", str(tmp_path / "nan.npy"), "--nan", "transparent", "--transfer",
                "glow:1", "--size", "16", "--filter", "trilinear", "-o", str(tmp_path / "h.npy"))
     assert done.returncode == 0, done.stderr

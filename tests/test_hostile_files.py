@@ -198,7 +198,29 @@ def build_cases(root):
     cases["output-is-input"] = (["render", str(folder / "keep.npy"), "--size", "8", "-o",
                                  str(folder / "keep.npy")], "is the input volume")
     (folder / "noise.npy").write_bytes(os.urandom(300))
-    cases["npy-random-bytes"] = (info(folder / "noise.npy"), "noise.npy")
+    cases["npy-random-bytes"] = (info(folder / "noise.npy"), "the .npy signature")
+    import tifffile
+
+    tifffile.imwrite(folder / "wide.tif", np.zeros((2, 8, 8), np.uint8),
+                     compression="zlib")
+    raw = bytearray((folder / "wide.tif").read_bytes())
+    for tag in (256, 257):  # ImageWidth and ImageLength claim 60000 on every page
+        for at in range(len(raw) - 12):
+            kind = int.from_bytes(raw[at + 2:at + 4], "little")
+            if raw[at:at + 2] == tag.to_bytes(2, "little") and kind in (3, 4) and \
+                    raw[at + 4:at + 8] == (1).to_bytes(4, "little"):
+                raw[at + 8:at + 8 + (2 if kind == 3 else 4)] = (60000).to_bytes(
+                    2 if kind == 3 else 4, "little")
+    (folder / "wide.tif").write_bytes(bytes(raw))
+    cases["tiff-claims-huge"] = (info(folder / "wide.tif"), "wide.tif")
+    grid = folder / "nan.vti"
+    grid.write_text(
+        '<?xml version="1.0"?>\n<VTKFile type="ImageData" version="1.0">\n'
+        '<ImageData WholeExtent="0 1 0 1 0 1" Origin="0 0 0" Spacing="nan 1 1">\n'
+        '<Piece Extent="0 1 0 1 0 1"><PointData Scalars="v">'
+        '<DataArray type="Float32" Name="v" format="ascii">0 1 2 3 4 5 6 7</DataArray>'
+        '</PointData></Piece></ImageData></VTKFile>\n')
+    cases["vti-nan-spacing"] = (info(grid), "must be 3 finite numbers")
     return cases
 
 
@@ -224,7 +246,8 @@ CASE_IDS = ["nhdr-parent", "nhdr-deeper", "nhdr-absolute", "nhdr-symlink-out",
             "nifti-dim8.nii", "nifti-dimneg.nii", "nifti-negative.nii", "nifti-zeros.nii",
             "turntable-frames", "field-count", "vti-corrupt", "vtk-ascii-short",
             "npy-values-overflow", "dicom-sub-folders", "unsupported-format",
-            "classified-method", "shape-on-npy", "empty-cmap", "python-words"]
+            "classified-method", "shape-on-npy", "empty-cmap", "python-words",
+            "tiff-claims-huge", "vti-nan-spacing"]
 
 
 @pytest.mark.parametrize("case", CASE_IDS)
