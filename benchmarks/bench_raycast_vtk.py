@@ -48,9 +48,12 @@ def scenes():
 
 
 class VTKCaster:
-    """VTK's fixed-point CPU ray caster set up to render exactly the glow model."""
+    """VTK's fixed-point CPU ray caster (or, with ``mapper="gpu"``, its GPU ray caster on
+    whatever OpenGL the machine has: Mesa's llvmpipe without a GPU) set up to render exactly
+    the emission-absorption model of ``transfer``: segment opacity from the density at the
+    sample distance, colour from the emission (premultiplied over black)."""
 
-    def __init__(self, volume, view, transfer, sample_distance):
+    def __init__(self, volume, view, transfer, sample_distance, mapper="fixed_point"):
         import pyvista as pv
         import vtk
 
@@ -61,7 +64,7 @@ class VTKCaster:
         grid.point_data["v"] = np.ascontiguousarray(volume.data, dtype=np.float32).ravel()
         self.plotter = pv.Plotter(off_screen=True, window_size=(view.width, view.height))
         self.plotter.set_background("black")
-        actor = self.plotter.add_volume(grid, scalars="v", mapper="fixed_point",
+        actor = self.plotter.add_volume(grid, scalars="v", mapper=mapper,
                                         show_scalar_bar=False)
         self.mapper = actor.GetMapper()
         self.mapper.SetAutoAdjustSampleDistances(0)
@@ -71,13 +74,14 @@ class VTKCaster:
         prop = actor.GetProperty()
         unit = sample_distance
         opacity = vtk.vtkPiecewiseFunction()
-        lo, hi = volume.value_range
-        for v in np.linspace(lo, hi, 1025):
-            density = float(transfer.opacity_density(np.array([v]))[0])
-            opacity.AddPoint(float(v), float(-np.expm1(-density * unit)))
         colour = vtk.vtkColorTransferFunction()
-        colour.AddRGBPoint(lo, 1.0, 1.0, 1.0)
-        colour.AddRGBPoint(hi, 1.0, 1.0, 1.0)
+        lo, hi = volume.value_range
+        values = np.linspace(lo, hi, 1025)
+        densities = np.asarray(transfer.opacity_density(values), dtype=float)
+        emission = np.asarray(transfer.emission(values), dtype=float)
+        for v, density, rgb in zip(values, densities, emission, strict=True):
+            opacity.AddPoint(float(v), float(-np.expm1(-density * unit)))
+            colour.AddRGBPoint(float(v), *(float(c) for c in rgb))
         prop.SetScalarOpacity(opacity)
         prop.SetScalarOpacityUnitDistance(unit)
         prop.SetColor(colour)
@@ -94,11 +98,18 @@ class VTKCaster:
         self.window = self.plotter.ren_win
 
     def render(self, threads):
-        self.mapper.SetNumberOfThreads(threads)
+        if hasattr(self.mapper, "SetNumberOfThreads"):  # the GPU mapper has none
+            self.mapper.SetNumberOfThreads(threads)
         self.window.Render()
+        self.window.WaitForCompletion()
 
     def image(self):
-        return self.plotter.screenshot(return_img=True)[..., 0] / 255.0
+        """The red channel: the glow model's alpha when the emission is white."""
+        return self.colour()[..., 0]
+
+    def colour(self):
+        """Premultiplied RGB (the volume composited over black), 8 bits per channel."""
+        return self.plotter.screenshot(return_img=True)[..., :3] / 255.0
 
     def close(self):
         self.plotter.close()

@@ -35,8 +35,8 @@ from vrlib import validate
 from vrlib.volume import Volume, fitted_extent
 
 __all__ = ["load", "load_npy", "load_nifti", "load_raw", "load_nrrd", "load_tiff", "load_vtk",
-           "load_dicom", "load_den", "fitted_extent", "nifti_orientation", "nifti_volume",
-           "FORMATS", "OBLIQUE"]
+           "load_dicom", "load_dicom_file", "load_den", "fitted_extent", "nifti_orientation",
+           "nifti_volume", "FORMATS", "OBLIQUE"]
 
 
 def _existing(path):
@@ -61,8 +61,19 @@ def _quiet(library):
         logger.setLevel(level)
 
 
+# Messages from the libraries' parsers that mean the bytes ran out or make no sense.
+_CORRUPT = re.compile(r"unpack requires|not enough values to unpack|division or modulo by "
+                      r"zero|mmap length|out of range|cannot reshape|cannot be reshaped|"
+                      r"^Expected \d+ bytes|StopIteration|EOF|truncated|Error -\d while "
+                      r"decompressing", re.IGNORECASE)
+
+
 def _unreadable(path, kind, error):
+    """The one-line error for a file its library cannot read, its words kept, and what a
+    low-level one means said first."""
     text = str(error).splitlines()[0] if str(error) else type(error).__name__
+    if _CORRUPT.search(text) or isinstance(error, StopIteration | EOFError):
+        text = f"it is truncated or corrupt ({text})"
     return ValueError(f"{Path(path).name} is not a readable {kind} file: {text}")
 
 
@@ -102,7 +113,7 @@ def load_npy(path, *, spacing=None, origin=None, extent=None, nan="error"):
         raise _unreadable(path, ".npy", "it does not start with the .npy signature")
     try:
         data = np.load(path, mmap_mode="r", allow_pickle=False)
-    except (ValueError, OSError, EOFError) as error:
+    except Exception as error:  # numpy's header parser raises several kinds
         text = str(error)
         if "pickle" in text.lower():
             text = "it holds Python objects, not a numeric array"
@@ -449,7 +460,9 @@ def load_vtk(path, *, scalars=None, extent=None, nan="error"):
     points, cells = list(grid.point_data.keys()), list(grid.cell_data.keys())
     name = scalars if scalars is not None else grid.active_scalars_name or (
         points[0] if points else cells[0] if cells else None)
-    if name is None or (name not in points and name not in cells):
+    if name is None:
+        raise ValueError(f"{path.name} holds no point or cell arrays: no values to render")
+    if name not in points and name not in cells:
         raise ValueError(f"{path.name}: no array {name!r}; point arrays {points}, cell arrays "
                          f"{cells} (choose one with scalars=)")
     spacing = np.asarray(grid.spacing, dtype=np.float64)
@@ -625,17 +638,7 @@ def _stack_dicom(folder, members, extent, nan):
         if "ImagePositionPatient" not in ds:
             raise ValueError(f"{file.name} has no ImagePositionPatient: cannot order slices")
         positions.append(float(np.dot(np.asarray(ds.ImagePositionPatient, float), normal)))
-    order = np.argsort(positions)
-    depth = np.diff(np.asarray(positions)[order])
-    if np.any(depth <= 0):
-        raise ValueError(f"{folder.name}: two slices share a position: a repeated slice or "
-                         "mixed series")
-    gap = float(np.median(depth))
-    if np.any(np.abs(depth - gap) > 0.01 * gap):
-        worst = int(np.argmax(np.abs(depth - gap)))
-        raise ValueError(f"{folder.name}: slices are unevenly spaced ({depth[worst]:g} against "
-                         f"{gap:g} mm between positions {positions[order[worst]]:g} and "
-                         f"{positions[order[worst + 1]]:g}): missing slices?")
+    order, gap = _slice_order(positions, folder.name)
     planes = []
     for index in order:
         file, ds = members[index]
@@ -652,6 +655,83 @@ def _stack_dicom(folder, members, extent, nan):
     first = members[order[0]][1]
     origin = np.asarray(first.ImagePositionPatient, dtype=np.float64)
     return _volume(data, extent, (pixel[1], pixel[0], gap), origin, nan)
+
+
+def _slice_order(positions, name):
+    """``(order, gap)``: the slices sorted along their normal and their even spacing; a
+    repeated position or an uneven gap (a missing slice) is refused."""
+    order = np.argsort(positions)
+    depth = np.diff(np.asarray(positions)[order])
+    if np.any(depth <= 0):
+        raise ValueError(f"{name}: two slices share a position: a repeated slice or "
+                         "mixed series")
+    gap = float(np.median(depth))
+    if np.any(np.abs(depth - gap) > 0.01 * gap):
+        worst = int(np.argmax(np.abs(depth - gap)))
+        raise ValueError(f"{name}: slices are unevenly spaced ({depth[worst]:g} against "
+                         f"{gap:g} mm between positions {positions[order[worst]]:g} and "
+                         f"{positions[order[worst + 1]]:g}): missing slices?")
+    return order, gap
+
+
+def load_dicom_file(path, *, extent=None, nan="error"):
+    """Load a single multi-frame DICOM file (an enhanced CT or MR image: one frame per
+    slice, its geometry in the functional groups), ordered along the slice normal as a
+    series is; each frame's rescale applied.
+
+    Examples
+    --------
+    >>> import tempfile, pathlib
+    >>> from data_gen.dicom import write_multiframe
+    >>> f = write_multiframe(pathlib.Path(tempfile.mkdtemp()) / "v.dcm",
+    ...                      np.zeros((3, 4, 5), np.int16), spacing=(0.5, 0.5, 2.0))
+    >>> vol = load_dicom_file(f)
+    >>> vol.shape, vol.spacing.tolist()
+    ((3, 4, 5), [0.5, 0.5, 2.0])
+    """
+    import pydicom
+
+    path = _existing(path)
+    try:
+        ds = pydicom.dcmread(path)
+        frames = int(ds.get("NumberOfFrames", 1))
+        if "PixelData" not in ds:
+            raise ValueError(f"{path.name} holds no pixel data")
+        if frames < 2:
+            raise ValueError(f"{path.name} holds one slice, not a volume: give the folder of "
+                             "its series")
+        check_allocation(frames * int(ds.Rows) * int(ds.Columns), np.float64, path.name)
+        shared = ds.SharedFunctionalGroupsSequence[0]
+        per_frame = ds.PerFrameFunctionalGroupsSequence
+        measures = shared.PixelMeasuresSequence[0]
+        pixel = np.asarray(measures.PixelSpacing, dtype=np.float64)  # rows (y), columns (x)
+        groups = [g.PlaneOrientationSequence[0] if "PlaneOrientationSequence" in g else
+                  shared.PlaneOrientationSequence[0] for g in per_frame]
+        cosines = np.asarray(groups[0].ImageOrientationPatient, dtype=np.float64).reshape(2, 3)
+        corners = [np.asarray(g.PlanePositionSequence[0].ImagePositionPatient, np.float64)
+                   for g in per_frame]
+        scales = []
+        for g in per_frame:
+            scale = (g if "PixelValueTransformationSequence" in g else shared)
+            transform = (scale.PixelValueTransformationSequence[0]
+                         if "PixelValueTransformationSequence" in scale else {})
+            scales.append((float(transform.get("RescaleSlope", 1.0)),
+                           float(transform.get("RescaleIntercept", 0.0))))
+        pixels = ds.pixel_array.astype(np.float64)
+    except ValueError:
+        raise
+    except Exception as error:  # pydicom raises many kinds on a corrupt or partial file
+        raise _unreadable(path, "multi-frame DICOM", error) from None
+    if len(corners) != frames or pixels.shape[0] != frames:
+        raise ValueError(f"{path.name}: {frames} frames but {len(corners)} positions and "
+                         f"{pixels.shape[0]} images")
+    if any(not np.allclose(g.ImageOrientationPatient, groups[0].ImageOrientationPatient)
+           for g in groups):
+        raise ValueError(f"{path.name}: its frames lie in differently oriented planes")
+    normal = np.cross(cosines[0], cosines[1])
+    order, gap = _slice_order([float(np.dot(c, normal)) for c in corners], path.name)
+    data = np.stack([pixels[i] * scales[i][0] + scales[i][1] for i in order])
+    return _volume(data, extent, (pixel[1], pixel[0], gap), corners[order[0]], nan)
 
 
 # VolPack's .den header (Levoy's format): 28 shorts (version, then original, extracted and
@@ -705,7 +785,7 @@ def load_den(path, *, extent=None, nan="error"):
 #: The loader :func:`load` takes for each file name ending (a DICOM series is a folder).
 FORMATS = {".npy": load_npy, ".nii": load_nifti, ".nii.gz": load_nifti, ".raw": load_raw,
            ".nrrd": load_nrrd, ".nhdr": load_nrrd, ".tif": load_tiff, ".tiff": load_tiff,
-           ".vti": load_vtk, ".vtk": load_vtk, ".den": load_den}
+           ".vti": load_vtk, ".vtk": load_vtk, ".den": load_den, ".dcm": load_dicom_file}
 
 
 def load(source, **options):

@@ -12,7 +12,7 @@ import tifffile
 
 import data_gen
 import vrlib
-from data_gen.dicom import write_series
+from data_gen.dicom import write_multiframe, write_series
 from vrlib.parallel.sources import memory_map, open_source
 
 DATA = np.random.default_rng(0).integers(0, 1000, (4, 5, 6)).astype(np.int16)  # [z, y, x]
@@ -134,6 +134,22 @@ def test_dicom_series_sorted_scaled_and_spaced(tmp_path):
     np.testing.assert_array_equal(vol.data, hounsfield)
     np.testing.assert_allclose(vol.spacing, [0.7, 0.7, 2.5])
     np.testing.assert_allclose(vol.origin, [-10, -20, 30])
+
+
+def test_dicom_multiframe_file_matches_its_series(tmp_path):
+    """One enhanced CT file, its frames stored last plane first, loads as the series of the
+    same planes does: sorted along the normal, rescaled, spaced."""
+    hounsfield = DATA.astype(np.float64) * 2 - 1024
+    write_series(tmp_path / "series", hounsfield, spacing=(0.7, 0.7, 2.5),
+                 origin=(-10, -20, 30), slope=2.0, intercept=-1024.0)
+    write_multiframe(tmp_path / "v.dcm", hounsfield, spacing=(0.7, 0.7, 2.5),
+                     origin=(-10, -20, 30), slope=2.0, intercept=-1024.0, reverse=True)
+    series, single = data_gen.load(tmp_path / "series"), data_gen.load(tmp_path / "v.dcm")
+    np.testing.assert_array_equal(single.data, series.data)
+    np.testing.assert_allclose(single.extent, series.extent)
+    write_series(tmp_path / "one", DATA[:1])
+    with pytest.raises(ValueError, match="holds one slice, not a volume"):
+        data_gen.load(next((tmp_path / "one").iterdir()))
 
 
 def test_dicom_bad_series(tmp_path):
