@@ -14,9 +14,9 @@ import vrlib
 SCRIPT = Path(sys.executable).parent / "vrlib"
 
 
-def run(*args, module=False, cwd=None):
+def run(*args, module=False, cwd=None, env=None):
     command = [sys.executable, "-m", "vrlib", *args] if module else [str(SCRIPT), *args]
-    env = dict(os.environ)
+    env = {**os.environ, **(env or {})}
     if "NUMBA_CACHE_DIR" in env:  # the JIT cache stays where it is, whatever the cwd
         env["NUMBA_CACHE_DIR"] = str(Path(env["NUMBA_CACHE_DIR"]).resolve())
     return subprocess.run(command, capture_output=True, text=True, timeout=300, cwd=cwd,
@@ -217,7 +217,8 @@ def test_nan_samples_refused_or_holes(tmp_path):
 def test_an_empty_image_says_why_in_one_line(tmp_path):
     done = run("render", "gaussian-blob:12", "--cmap", "gray", "--opacity", "0:0,1:0", "--size",
                "8", "-o", str(tmp_path / "e.png"))
-    lines = done.stderr.strip().splitlines()
+    lines = [line for line in done.stderr.strip().splitlines()
+             if not line.startswith("vrlib: note: compiling")]  # said on a cold cache
     assert done.returncode == 0 and len(lines) == 1, done.stderr
     assert lines[0].startswith("vrlib: warning: the transfer function") and "transparent" in \
         lines[0]
@@ -238,6 +239,23 @@ def test_render_a_dicom_folder(tmp_path):
 def test_version():
     done = run("--version")
     assert done.returncode == 0 and done.stdout.strip() == f"vrlib {vrlib.__version__}"
+
+
+def test_compiling_is_said_once(capsys):
+    """The command line says once, when numba first compiles, that it does (a cold cache's
+    wait is 10 to 20 s); later compiles in the same run say nothing."""
+    import numba
+
+    from vrlib import cli
+
+    cli._say_when_compiling()
+    cli._say_when_compiling()  # the listener is registered once
+    cli._say_when_compiling.said = False  # as in a fresh process
+    capsys.readouterr()
+    for offset in (1, 2):
+        numba.njit(lambda x, offset=offset: x + offset)(1)  # a compile, not a cache load
+    notes = [line for line in capsys.readouterr().err.splitlines() if "compiling" in line]
+    assert len(notes) == 1 and notes[0].startswith("vrlib: note: compiling the renderer's")
 
 
 def test_argparse_errors_exit_2():

@@ -717,6 +717,31 @@ def _as_flags(text):
     return re.sub(rf"(?<![\w-])({names})=(?:'([^']*)'|([^\s,;)]*))", flag, text)
 
 
+#: What the command line says when numba compiles (:func:`_say_when_compiling`).
+_COMPILING = ("compiling the renderer's kernels for this machine, once (10 to 20 s; later "
+              "runs load them from the cache)")
+
+
+def _say_when_compiling():
+    """Say once, on stderr, when numba starts compiling a kernel (a first run on a machine, or
+    a first use of a kernel variant): a wait with nothing said looks like a hang. Loading a
+    compiled kernel from the cache raises no compile event, so a warm run says nothing."""
+    from numba.core import event
+
+    class Note(event.Listener):
+        def on_start(self, ev):
+            if not _say_when_compiling.said:
+                _say_when_compiling.said = True
+                print(f"vrlib: note: {_COMPILING}", file=sys.stderr, flush=True)
+
+        def on_end(self, ev):
+            pass
+
+    if not hasattr(_say_when_compiling, "said"):
+        _say_when_compiling.said = False
+        event.register("numba:compile", Note())
+
+
 def main(argv=None):
     """Run the command line; returns the exit status (2 on bad input).
 
@@ -727,6 +752,7 @@ def main(argv=None):
     """
     argv = sys.argv[1:] if argv is None else list(argv)
     args = parser().parse_args(_signed_values(argv))
+    _say_when_compiling()
     try:
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always", EmptyImageWarning)
