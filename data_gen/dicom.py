@@ -11,6 +11,26 @@ import numpy as np
 __all__ = ["write_series", "write_multiframe"]
 
 
+def _ct_dataset(sop_class, study, series, shape):
+    """A CT dataset of ``sop_class`` with its file meta, study and series, and 16-bit signed
+    monochrome pixels of ``shape`` (rows, columns), its pixel data still to set."""
+    from pydicom.dataset import Dataset, FileMetaDataset
+    from pydicom.uid import ExplicitVRLittleEndian, generate_uid
+
+    meta = FileMetaDataset()
+    meta.MediaStorageSOPClassUID = sop_class
+    meta.MediaStorageSOPInstanceUID = generate_uid()
+    meta.TransferSyntaxUID = ExplicitVRLittleEndian
+    ds = Dataset()
+    ds.file_meta = meta
+    ds.SOPClassUID, ds.SOPInstanceUID = sop_class, meta.MediaStorageSOPInstanceUID
+    ds.Modality, ds.StudyInstanceUID, ds.SeriesInstanceUID = "CT", study, series
+    ds.Rows, ds.Columns = shape
+    ds.SamplesPerPixel, ds.PhotometricInterpretation = 1, "MONOCHROME2"
+    ds.BitsAllocated, ds.BitsStored, ds.HighBit, ds.PixelRepresentation = 16, 16, 15, 1
+    return ds
+
+
 def write_series(folder, data, *, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0),
                  slope=1.0, intercept=0.0, series_uid=None, shuffle=False, prefix="slice"):
     """Write ``data[z, y, x]`` (integers) as one uncompressed DICOM CT slice per z plane.
@@ -38,8 +58,7 @@ def write_series(folder, data, *, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0
     >>> len(files), files[0].name
     (2, 'slice_0000.dcm')
     """
-    from pydicom.dataset import Dataset, FileMetaDataset
-    from pydicom.uid import CTImageStorage, ExplicitVRLittleEndian, generate_uid
+    from pydicom.uid import CTImageStorage, generate_uid
 
     folder = Path(folder)
     folder.mkdir(parents=True, exist_ok=True)
@@ -53,23 +72,13 @@ def write_series(folder, data, *, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0
     names = np.random.default_rng(0).permutation(nz) if shuffle else np.arange(nz)
     files = []
     for z in range(nz):
-        meta = FileMetaDataset()
-        meta.MediaStorageSOPClassUID = CTImageStorage
-        meta.MediaStorageSOPInstanceUID = generate_uid()
-        meta.TransferSyntaxUID = ExplicitVRLittleEndian
-        ds = Dataset()
-        ds.file_meta = meta
-        ds.SOPClassUID, ds.SOPInstanceUID = CTImageStorage, meta.MediaStorageSOPInstanceUID
-        ds.Modality, ds.StudyInstanceUID, ds.SeriesInstanceUID = "CT", study, series_uid
+        ds = _ct_dataset(CTImageStorage, study, series_uid, values.shape[1:])
         ds.InstanceNumber = z + 1
         ds.ImageOrientationPatient = [1, 0, 0, 0, 1, 0]
         ds.ImagePositionPatient = [float(origin[0]), float(origin[1]),
                                    float(origin[2] + z * spacing[2])]
         ds.PixelSpacing = [float(spacing[1]), float(spacing[0])]  # rows (y), columns (x)
         ds.SliceThickness = float(spacing[2])
-        ds.Rows, ds.Columns = values.shape[1:]
-        ds.SamplesPerPixel, ds.PhotometricInterpretation = 1, "MONOCHROME2"
-        ds.BitsAllocated, ds.BitsStored, ds.HighBit, ds.PixelRepresentation = 16, 16, 15, 1
         ds.RescaleSlope, ds.RescaleIntercept = float(slope), float(intercept)
         ds.PixelData = values[z].tobytes()
         path = folder / f"{prefix}_{int(names[z]):04d}.dcm"
@@ -91,25 +100,15 @@ def write_multiframe(path, data, *, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0
     ...                  np.zeros((2, 3, 4), np.int16)).name
     'v.dcm'
     """
-    from pydicom.dataset import Dataset, FileMetaDataset
+    from pydicom.dataset import Dataset
     from pydicom.sequence import Sequence
-    from pydicom.uid import EnhancedCTImageStorage, ExplicitVRLittleEndian, generate_uid
+    from pydicom.uid import EnhancedCTImageStorage, generate_uid
 
     path = Path(path)
     values = np.rint((np.asarray(data, dtype=np.float64) - intercept) / slope).astype(np.int16)
     order = range(values.shape[0] - 1, -1, -1) if reverse else range(values.shape[0])
-    meta = FileMetaDataset()
-    meta.MediaStorageSOPClassUID = EnhancedCTImageStorage
-    meta.MediaStorageSOPInstanceUID = generate_uid()
-    meta.TransferSyntaxUID = ExplicitVRLittleEndian
-    ds = Dataset()
-    ds.file_meta = meta
-    ds.SOPClassUID, ds.SOPInstanceUID = EnhancedCTImageStorage, meta.MediaStorageSOPInstanceUID
-    ds.Modality, ds.StudyInstanceUID, ds.SeriesInstanceUID = "CT", generate_uid(), generate_uid()
+    ds = _ct_dataset(EnhancedCTImageStorage, generate_uid(), generate_uid(), values.shape[1:])
     ds.NumberOfFrames = values.shape[0]
-    ds.Rows, ds.Columns = values.shape[1:]
-    ds.SamplesPerPixel, ds.PhotometricInterpretation = 1, "MONOCHROME2"
-    ds.BitsAllocated, ds.BitsStored, ds.HighBit, ds.PixelRepresentation = 16, 16, 15, 1
     measures, orientation, transform = Dataset(), Dataset(), Dataset()
     measures.PixelSpacing = [float(spacing[1]), float(spacing[0])]
     measures.SliceThickness = float(spacing[2])
