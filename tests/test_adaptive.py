@@ -44,10 +44,18 @@ def _cast(vol, view, filt, transfer, step, multiplier, *, ends="lattice", data=N
     return rgba, taken
 
 
-@pytest.mark.parametrize("ends", ["lattice", "exact"])
-@pytest.mark.parametrize("projection", ["orthographic", "perspective"])
-@pytest.mark.parametrize("filt", ["trilinear", "catmull-rom"])
-@pytest.mark.parametrize("transfer", [Glow(3.0), TABLE], ids=["glow", "table"])
+# One combination of each choice runs in make test, every combination in make test-all.
+TWIN_CASES = [pytest.param(ends, projection, filt, transfer, id=f"{ends}-{projection}-{filt}-"
+                           f"{name}", marks=() if (ends, projection, filt, name) in {
+                               ("lattice", "orthographic", "trilinear", "glow"),
+                               ("exact", "perspective", "catmull-rom", "table")}
+                           else pytest.mark.slow)
+              for ends in ("lattice", "exact") for projection in ("orthographic", "perspective")
+              for filt in ("trilinear", "catmull-rom")
+              for name, transfer in (("glow", Glow(3.0)), ("table", TABLE))]
+
+
+@pytest.mark.parametrize(("ends", "projection", "filt", "transfer"), TWIN_CASES)
 def test_long_segments_match_naive_twin(ends, projection, filt, transfer):
     """The kernel's long segments (aligned runs of 2, 4 or 8 steps inside one block, sampled
     at their middle) equal the twin's, for random multipliers on a volume of 3x2x3 blocks."""

@@ -128,11 +128,21 @@ def test_render_reads_files(tmp_path):
       "x.png"], "use --method raycast or --method auto"),
     (["render", "gaussian-blob:8", "--tolerance", "2", "-o", "x.png"], "tolerance"),
 ])
-def test_bad_input_exits_2_with_one_line(tmp_path, args, message):
-    done = run(*args, cwd=tmp_path)
-    assert done.returncode == 2
-    lines = done.stderr.strip().splitlines()
-    assert len(lines) == 1 and message in lines[0], done.stderr
+def test_bad_input_exits_2_with_one_line(tmp_path, monkeypatch, capsys, args, message):
+    """In process (the installed script is run in the tests around this one): the same
+    ``main`` the script calls, without a Python start per case."""
+    from vrlib import cli
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr(cli, "_say_when_compiling", lambda: None)
+    try:
+        status = cli.main(list(args))
+    except SystemExit as done:  # argparse's own errors
+        status = done.code
+    stderr = capsys.readouterr().err
+    assert status == 2
+    lines = stderr.strip().splitlines()
+    assert len(lines) == 1 and message in lines[0], stderr
     assert not any(tmp_path.iterdir()), "nothing may be written on bad input"
 
 

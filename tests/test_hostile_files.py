@@ -390,6 +390,7 @@ def _good_files(folder):
     return sorted(folder.iterdir())
 
 
+@pytest.mark.slow  # 12 s: in make test-all
 def test_corrupted_copies_of_every_format_never_raise(tmp_path):
     """Truncated, bit-flipped and overwritten copies of a good file of every format: each
     is read (a flip in the samples changes only values) or refused in one line naming it,
