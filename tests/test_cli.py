@@ -14,7 +14,12 @@ import vrlib
 SCRIPT = Path(sys.executable).parent / "vrlib"
 
 
-def run(*args, module=False, cwd=None, env=None):
+def run(*args, module=False, cwd=None, env=None, script=False):
+    """``vrlib ARGS`` as a ``CompletedProcess``: the installed script (``script``) or
+    ``python -m vrlib`` (``module``) in a process of their own, else the ``main`` they call,
+    in this process (its output captured, in ``cwd``), which saves a Python start per call."""
+    if not (script or module or env):
+        return _in_process(args, cwd)
     command = [sys.executable, "-m", "vrlib", *args] if module else [str(SCRIPT), *args]
     env = {**os.environ, **(env or {})}
     if "NUMBA_CACHE_DIR" in env:  # the JIT cache stays where it is, whatever the cwd
@@ -23,11 +28,30 @@ def run(*args, module=False, cwd=None, env=None):
                           env=env, check=False)
 
 
+def _in_process(args, cwd):
+    import contextlib
+    import io
+
+    from vrlib import cli
+
+    out, err, before = io.StringIO(), io.StringIO(), os.getcwd()
+    try:
+        os.chdir(cwd or before)
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            try:
+                status = cli.main(list(args))
+            except SystemExit as done:  # argparse's help, version and errors
+                status = done.code if isinstance(done.code, int) else 0
+    finally:
+        os.chdir(before)
+    return subprocess.CompletedProcess(args, status, out.getvalue(), err.getvalue())
+
+
 def test_render_writes_the_image_both_ways(tmp_path):
-    for module in (False, True):
+    for module in (False, True):  # the installed script, and python -m vrlib
         out = tmp_path / f"ml{int(module)}.png"
         done = run("render", "marschner-lobb:17", "--size", "24", "-o", str(out),
-                   module=module)
+                   module=module, script=not module)
         assert done.returncode == 0, done.stderr
         assert out.read_bytes().startswith(b"\x89PNG")
 
@@ -247,7 +271,7 @@ def test_render_a_dicom_folder(tmp_path):
 
 
 def test_version():
-    done = run("--version")
+    done = run("--version", script=True)
     assert done.returncode == 0 and done.stdout.strip() == f"vrlib {vrlib.__version__}"
 
 
@@ -270,7 +294,7 @@ def test_compiling_is_said_once(capsys):
 
 def test_argparse_errors_exit_2():
     """In one line, as the command's own errors, not argparse's usage block."""
-    done = run("render", "marschner-lobb:17")  # no -o
+    done = run("render", "marschner-lobb:17", script=True)  # no -o
     lines = done.stderr.strip().splitlines()
     assert done.returncode == 2 and len(lines) == 1 and "-o/--output" in lines[0]
     assert lines[0].startswith("vrlib: error: ")
