@@ -32,6 +32,8 @@ def pytest_collection_finish(session):
     (``tests/warm_kernels.py`` says why); not when numba's JIT is off."""
     if len(session.items) < _FULL_RUN or os.environ.get("NUMBA_DISABLE_JIT") == "1":
         return
+    if os.environ.get("PYTEST_XDIST_WORKER", "gw0") != "gw0":
+        return  # under xdist every worker collects the session: one compiling beside is enough
     session.config.warm_kernels = subprocess.Popen(
         [sys.executable, str(Path(__file__).parent / "warm_kernels.py")],
         stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
