@@ -11,6 +11,15 @@ import numpy as np
 __all__ = ["write_series", "write_multiframe"]
 
 
+#: Rows along RAS +x and columns along RAS +y, in DICOM's patient coordinates (LPS).
+_RAS_AXES_IN_LPS = [-1, 0, 0, 0, -1, 0]
+
+
+def _lps(origin, depth):
+    """The RAS point ``origin`` raised by ``depth`` along z, in patient coordinates (LPS)."""
+    return [-float(origin[0]), -float(origin[1]), float(origin[2] + depth)]
+
+
 def _ct_dataset(sop_class, study, series, shape):
     """A CT dataset of ``sop_class`` with its file meta, study and series, and 16-bit signed
     monochrome pixels of ``shape`` (rows, columns), its pixel data still to set."""
@@ -33,7 +42,8 @@ def _ct_dataset(sop_class, study, series, shape):
 
 def write_series(folder, data, *, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0),
                  slope=1.0, intercept=0.0, series_uid=None, shuffle=False, prefix="slice"):
-    """Write ``data[z, y, x]`` (integers) as one uncompressed DICOM CT slice per z plane.
+    """Write ``data[z, y, x]`` (integers) as one uncompressed DICOM CT slice per z plane,
+    its RAS geometry written in DICOM's patient coordinates (LPS).
 
     Stored values are ``(data - intercept) / slope`` as 16-bit integers, so a loader that
     applies ``RescaleSlope`` and ``RescaleIntercept`` gets ``data`` back.
@@ -74,9 +84,8 @@ def write_series(folder, data, *, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0.0
     for z in range(nz):
         ds = _ct_dataset(CTImageStorage, study, series_uid, values.shape[1:])
         ds.InstanceNumber = z + 1
-        ds.ImageOrientationPatient = [1, 0, 0, 0, 1, 0]
-        ds.ImagePositionPatient = [float(origin[0]), float(origin[1]),
-                                   float(origin[2] + z * spacing[2])]
+        ds.ImageOrientationPatient = _RAS_AXES_IN_LPS
+        ds.ImagePositionPatient = _lps(origin, z * spacing[2])
         ds.PixelSpacing = [float(spacing[1]), float(spacing[0])]  # rows (y), columns (x)
         ds.SliceThickness = float(spacing[2])
         ds.RescaleSlope, ds.RescaleIntercept = float(slope), float(intercept)
@@ -112,7 +121,7 @@ def write_multiframe(path, data, *, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0
     measures, orientation, transform = Dataset(), Dataset(), Dataset()
     measures.PixelSpacing = [float(spacing[1]), float(spacing[0])]
     measures.SliceThickness = float(spacing[2])
-    orientation.ImageOrientationPatient = [1, 0, 0, 0, 1, 0]
+    orientation.ImageOrientationPatient = _RAS_AXES_IN_LPS
     transform.RescaleSlope, transform.RescaleIntercept = float(slope), float(intercept)
     shared = Dataset()
     shared.PixelMeasuresSequence = Sequence([measures])
@@ -122,8 +131,7 @@ def write_multiframe(path, data, *, spacing=(1.0, 1.0, 1.0), origin=(0.0, 0.0, 0
     frames = []
     for z in order:
         position, group = Dataset(), Dataset()
-        position.ImagePositionPatient = [float(origin[0]), float(origin[1]),
-                                         float(origin[2] + z * spacing[2])]
+        position.ImagePositionPatient = _lps(origin, z * spacing[2])
         group.PlanePositionSequence = Sequence([position])
         frames.append(group)
     ds.PerFrameFunctionalGroupsSequence = Sequence(frames)

@@ -314,10 +314,7 @@ def nifti_volume(image, name, *, frame=None, extent=None, nan="error", oblique="
         try:
             axis_aligned(affine[:3, :3].T, name)
         except ValueError as error:
-            if "oblique" not in str(error):
-                raise
-            raise ValueError(f"{error}; or take the voxel axes as they are with "
-                             "oblique='voxel-axes' (--oblique voxel-axes)") from None
+            raise _oblique_hint(error) from None
     ornt, spacing, origin = nifti_orientation(image)
     data = orientations.apply_orientation(data, ornt)
     data = np.ascontiguousarray(data.transpose(2, 1, 0))  # (i, j, k) -> [z, y, x]
@@ -564,7 +561,7 @@ def _check_vtk_claims(path):
                              "truncated?")
 
 
-def load_dicom(folder, *, series=None, extent=None, nan="error"):
+def load_dicom(folder, *, series=None, extent=None, nan="error", oblique="refuse"):
     """Load a DICOM series (a folder of slice files) through pydicom.
 
     Slices are ordered by their position along the slice normal (``ImagePositionPatient``
@@ -572,7 +569,9 @@ def load_dicom(folder, *, series=None, extent=None, nan="error"):
     the distance between positions, and each slice's ``RescaleSlope`` and
     ``RescaleIntercept`` are applied. A folder with several series needs ``series`` (a
     ``SeriesInstanceUID``, or its last digits); missing slices (an uneven gap) and slices of
-    other sizes are refused.
+    other sizes are refused. The patient coordinates (LPS) are turned to RAS exactly, rows
+    and columns running against an axis flipped; an oblique series is refused unless
+    ``oblique="voxel-axes"`` (:func:`load_nifti`).
 
     Examples
     --------
@@ -587,6 +586,7 @@ def load_dicom(folder, *, series=None, extent=None, nan="error"):
     import pydicom
     from pydicom.errors import InvalidDicomError
 
+    validate.choice("oblique", oblique, OBLIQUE)
     folder = Path(folder)
     if not folder.is_dir():
         raise FileNotFoundError(f"no DICOM folder at {str(folder)!r}")
@@ -621,10 +621,10 @@ def load_dicom(folder, *, series=None, extent=None, nan="error"):
     if len(members) < 2:
         raise ValueError(f"a DICOM series needs at least 2 slices, {folder.name} has "
                          f"{len(members)}")
-    return _stack_dicom(folder, members, extent, nan)
+    return _stack_dicom(folder, members, extent, nan, oblique)
 
 
-def _stack_dicom(folder, members, extent, nan):
+def _stack_dicom(folder, members, extent, nan, oblique):
     first = members[0][1]
     try:
         cosines = np.asarray(first.ImageOrientationPatient, dtype=np.float64).reshape(2, 3)
@@ -654,7 +654,38 @@ def _stack_dicom(folder, members, extent, nan):
     data = np.stack(planes)
     first = members[order[0]][1]
     origin = np.asarray(first.ImagePositionPatient, dtype=np.float64)
-    return _volume(data, extent, (pixel[1], pixel[0], gap), origin, nan)
+    return _dicom_volume(data, cosines, pixel, gap, origin, folder.name, extent, nan, oblique)
+
+
+def _dicom_volume(data, cosines, pixel, gap, origin, name, extent, nan, oblique):
+    """The volume of slices ``data[k, j, i]`` sorted along their normal: the rows' and
+    columns' direction ``cosines``, ``pixel`` spacing (row, column), slice ``gap`` and first
+    corner ``origin``, all in DICOM's patient coordinates (LPS), turned exactly to RAS as a
+    NIfTI volume is (:func:`data_gen.untrusted.to_world_axes`); an oblique grid is refused
+    unless ``oblique="voxel-axes"``."""
+    normal = np.cross(cosines[0], cosines[1])
+    directions = np.stack([cosines[0] * pixel[1], cosines[1] * pixel[0], normal * gap])
+    directions[:, :2] *= -1.0  # LPS -> RAS
+    origin = origin * np.array([-1.0, -1.0, 1.0])
+    if oblique == "voxel-axes":  # each voxel axis on its nearest world axis
+        nearest = np.argmax(np.abs(directions), axis=1)
+        snapped = np.zeros_like(directions)
+        snapped[np.arange(3), nearest] = (np.sign(directions[np.arange(3), nearest])
+                                          * np.linalg.norm(directions, axis=1))
+        directions = snapped
+    try:
+        data, spacing, origin = to_world_axes(data, directions, origin, name)
+    except ValueError as error:
+        raise _oblique_hint(error) from None
+    return _volume(data, extent, spacing, origin, nan)
+
+
+def _oblique_hint(error):
+    """``error`` with, for an oblique grid, how to take its voxel axes as they are."""
+    if "oblique" not in str(error):
+        return error
+    return ValueError(f"{error}; or take the voxel axes as they are with "
+                      "oblique='voxel-axes' (--oblique voxel-axes)")
 
 
 def _slice_order(positions, name):
@@ -674,10 +705,10 @@ def _slice_order(positions, name):
     return order, gap
 
 
-def load_dicom_file(path, *, extent=None, nan="error"):
+def load_dicom_file(path, *, extent=None, nan="error", oblique="refuse"):
     """Load a single multi-frame DICOM file (an enhanced CT or MR image: one frame per
-    slice, its geometry in the functional groups), ordered along the slice normal as a
-    series is; each frame's rescale applied.
+    slice, its geometry in the functional groups), ordered and oriented as a series is
+    (:func:`load_dicom`); each frame's rescale applied.
 
     Examples
     --------
@@ -691,6 +722,7 @@ def load_dicom_file(path, *, extent=None, nan="error"):
     """
     import pydicom
 
+    validate.choice("oblique", oblique, OBLIQUE)
     path = _existing(path)
     try:
         ds = pydicom.dcmread(path)
@@ -731,7 +763,8 @@ def load_dicom_file(path, *, extent=None, nan="error"):
     normal = np.cross(cosines[0], cosines[1])
     order, gap = _slice_order([float(np.dot(c, normal)) for c in corners], path.name)
     data = np.stack([pixels[i] * scales[i][0] + scales[i][1] for i in order])
-    return _volume(data, extent, (pixel[1], pixel[0], gap), corners[order[0]], nan)
+    return _dicom_volume(data, cosines, pixel, gap, corners[order[0]], path.name, extent, nan,
+                         oblique)
 
 
 # VolPack's .den header (Levoy's format): 28 shorts (version, then original, extracted and

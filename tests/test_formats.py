@@ -152,6 +152,41 @@ def test_dicom_multiframe_file_matches_its_series(tmp_path):
         data_gen.load(next((tmp_path / "one").iterdir()))
 
 
+def _reorient(files, orientation, positions):
+    """Rewrite a series' files with another ``ImageOrientationPatient`` and positions."""
+    import pydicom
+
+    for file, position in zip(sorted(files), positions, strict=True):
+        ds = pydicom.dcmread(file)
+        ds.ImageOrientationPatient = orientation
+        ds.ImagePositionPatient = [float(v) for v in position]
+        ds.save_as(file)
+
+
+def test_dicom_patient_axes_are_turned_to_ras(tmp_path):
+    """A series whose rows run along patient +x (LPS: towards the left) and columns along
+    patient +y (posterior), as a scanner writes an axial series, loads as the RAS volume:
+    flipped along x and y, its origin the RAS corner."""
+    files = write_series(tmp_path, DATA, spacing=(0.5, 0.75, 2.0))
+    _reorient(files, [1, 0, 0, 0, 1, 0], [(10.0, 20.0, 2.0 * z) for z in range(DATA.shape[0])])
+    vol = data_gen.load(tmp_path)
+    np.testing.assert_array_equal(vol.data, DATA[:, ::-1, ::-1])
+    nz, ny, nx = DATA.shape
+    np.testing.assert_allclose(vol.origin, [-10.0 - 0.5 * (nx - 1), -20.0 - 0.75 * (ny - 1),
+                                            0.0])
+    np.testing.assert_allclose(vol.spacing, [0.5, 0.75, 2.0])
+
+
+def test_dicom_oblique_series_refused_unless_asked(tmp_path):
+    files = write_series(tmp_path, DATA)
+    c, s = np.cos(0.3), np.sin(0.3)
+    _reorient(files, [c, s, 0.0, -s, c, 0.0], [(0.0, 0.0, float(z)) for z in
+                                                range(DATA.shape[0])])
+    with pytest.raises(ValueError, match="oblique or sheared.*voxel-axes"):
+        data_gen.load(tmp_path)
+    assert data_gen.load(tmp_path, oblique="voxel-axes").shape == DATA.shape
+
+
 def test_dicom_bad_series(tmp_path):
     write_series(tmp_path / "two", DATA, series_uid="1.2.3.4")
     write_series(tmp_path / "two", DATA[:, :4], series_uid="1.2.3.5", prefix="other")

@@ -122,8 +122,8 @@ def load_volume(spec, *, shape=None, dtype=None, offset=0, frame=None, series=No
         if nan != "error":
             options["nan"] = nan
         if oblique != "refuse":
-            if not name.endswith((".nii", ".nii.gz")):
-                raise UsageError("--oblique applies to .nii and .nii.gz files only")
+            if not (name.endswith((".nii", ".nii.gz", ".dcm")) or path.is_dir()):
+                raise UsageError("--oblique applies to NIfTI and DICOM volumes only")
             options["oblique"] = oblique
         if series is not None:
             if not path.is_dir():
@@ -284,8 +284,8 @@ def _add_volume(parser, optional=False):
     parser.add_argument("--spacing", help="X,Y,Z voxel size of a .npy, .raw or TIFF file "
                                           "(default the TIFF's own, else 1)")
     parser.add_argument("--oblique", default="refuse", choices=["refuse", "voxel-axes"],
-                        help="a NIfTI scan on an oblique grid: refuse it (default), or show it "
-                             "in its own voxel axes, the rotation left out")
+                        help="a NIfTI or DICOM scan on an oblique grid: refuse it (default), or "
+                             "show it in its own voxel axes, the rotation left out")
 
 
 def _add_scene(parser):
