@@ -36,7 +36,7 @@ from vrlib.volume import Volume, fitted_extent
 
 __all__ = ["load", "load_npy", "load_nifti", "load_raw", "load_nrrd", "load_tiff", "load_vtk",
            "load_dicom", "load_dicom_file", "load_den", "fitted_extent", "nifti_orientation",
-           "nifti_volume", "FORMATS", "OBLIQUE"]
+           "nifti_volume", "raw_dtype", "FORMATS", "OBLIQUE"]
 
 
 def _existing(path):
@@ -125,6 +125,35 @@ def load_npy(path, *, spacing=None, origin=None, extent=None, nan="error"):
     return _volume(data, extent, spacing, origin, nan)
 
 
+def raw_dtype(dtype, byteorder=None):
+    """The sample type of headerless samples: ``dtype`` in the byte order ``byteorder``
+    names, else the one ``dtype`` names (``">i2"``: big), else little; a ``byteorder`` that
+    contradicts ``dtype``'s is refused.
+
+    Examples
+    --------
+    >>> raw_dtype(">i2").str, raw_dtype("int16", "big").str, raw_dtype("float32").str
+    ('>i2', '>i2', '<f4')
+    """
+    try:
+        dt = np.dtype(dtype)
+    except TypeError:
+        raise ValueError(f"dtype must be a numpy sample type (uint8, int16, float32, ...), "
+                         f"got {dtype!r}") from None
+    if dt.kind not in "biuf":
+        raise ValueError(f"dtype must be a numpy sample type (uint8, int16, float32, ...), "
+                         f"got {dtype!r}")
+    named = {">": "big", "<": "little"}.get(str(dtype).strip()[:1]) if isinstance(
+        dtype, str) else None
+    if byteorder is not None:
+        validate.choice("byteorder", byteorder, ("little", "big"))
+        if named is not None and named != byteorder and dt.itemsize > 1:
+            raise ValueError(f"dtype {dtype!r} is {named}-endian but byteorder={byteorder!r}: "
+                             "give the byte order once")
+    order = byteorder or named or "little"
+    return dt.newbyteorder("<" if order == "little" else ">")
+
+
 def load_raw(path, shape, dtype, *, byteorder=None, offset=0, spacing=None, origin=None,
              extent=None, nan="error"):
     """Load headerless samples of ``shape = (nz, ny, nx)`` and ``dtype``, x varying fastest.
@@ -151,23 +180,7 @@ def load_raw(path, shape, dtype, *, byteorder=None, offset=0, spacing=None, orig
     shape = tuple(validate.positive_int("shape", n, minimum=2) for n in shape)
     if len(shape) != 3:
         raise ValueError(f"shape must be (nz, ny, nx), got {shape!r}")
-    try:
-        dt = np.dtype(dtype)
-    except TypeError:
-        raise ValueError(f"dtype must be a numpy sample type (uint8, int16, float32, ...), "
-                         f"got {dtype!r}") from None
-    if dt.kind not in "biuf":
-        raise ValueError(f"dtype must be a numpy sample type (uint8, int16, float32, ...), "
-                         f"got {dtype!r}")
-    named = {">": "big", "<": "little"}.get(str(dtype).strip()[:1]) if isinstance(
-        dtype, str) else None
-    if byteorder is not None:
-        validate.choice("byteorder", byteorder, ("little", "big"))
-        if named is not None and named != byteorder and dt.itemsize > 1:
-            raise ValueError(f"dtype {dtype!r} is {named}-endian but byteorder={byteorder!r}: "
-                             "give the byte order once")
-    order = byteorder or named or "little"
-    dt = dt.newbyteorder("<" if order == "little" else ">")
+    dt = raw_dtype(dtype, byteorder)
     offset = validate.positive_int("offset", offset, minimum=0)
     expected = offset + math.prod(shape) * dt.itemsize
     actual = path.stat().st_size
@@ -181,13 +194,19 @@ def load_raw(path, shape, dtype, *, byteorder=None, offset=0, spacing=None, orig
     return _volume(data, extent, spacing, origin, nan)
 
 
-def nifti_orientation(image):
+#: What a loader does with an oblique or sheared grid (``oblique=``).
+OBLIQUE = ("refuse", "voxel-axes")
+
+
+def nifti_orientation(image, *, oblique="refuse", name="NIfTI image"):
     """How a NIfTI image's voxel axes turn to RAS+: ``(ornt, spacing, origin)``.
 
     ``ornt`` is nibabel's orientation array (apply it with
     ``nibabel.orientations.apply_orientation`` to ``(i, j, k)`` data); ``spacing`` and
     ``origin`` are the RAS+ voxel sizes and the position of the reoriented first voxel, in
-    the file's units (mm).
+    the file's units (mm). An affine that is not finite, or (unless ``oblique="voxel-axes"``,
+    which takes each voxel axis on its closest world axis) not a signed permutation of the
+    world axes, is refused, naming ``name``: every reader of NIfTI files turns them here.
 
     Examples
     --------
@@ -200,17 +219,18 @@ def nifti_orientation(image):
     import nibabel
     from nibabel import orientations
 
+    validate.choice("oblique", oblique, OBLIQUE)
     affine = np.asarray(image.affine, dtype=np.float64)
+    if not np.all(np.isfinite(affine)):
+        raise ValueError(f"{name}: its affine is not finite: {affine[:3].tolist()}")
+    if oblique == "refuse":
+        axis_aligned(affine[:3, :3].T, name)
     shape = image.shape[:3]
     ornt = orientations.io_orientation(affine)
     transform = orientations.inv_ornt_aff(ornt, shape)
     canonical = affine @ transform
     spacing = np.asarray(nibabel.affines.voxel_sizes(canonical), dtype=np.float64)
     return ornt, spacing, canonical[:3, 3].copy()
-
-
-#: What a loader does with an oblique or sheared grid (``oblique=``).
-OBLIQUE = ("refuse", "voxel-axes")
 
 
 def load_nifti(path, *, frame=None, extent=None, nan="error", oblique="refuse"):
@@ -307,15 +327,10 @@ def nifti_volume(image, name, *, frame=None, extent=None, nan="error", oblique="
         if str(error).startswith("frame"):
             raise
         raise ValueError(f"{name} is not a readable NIfTI file: {error}") from None
-    affine = np.asarray(image.affine, dtype=np.float64)
-    if not np.all(np.isfinite(affine)):
-        raise ValueError(f"{name}: its affine is not finite: {affine[:3].tolist()}")
-    if oblique == "refuse":
-        try:
-            axis_aligned(affine[:3, :3].T, name)
-        except ValueError as error:
-            raise _oblique_hint(error) from None
-    ornt, spacing, origin = nifti_orientation(image)
+    try:
+        ornt, spacing, origin = nifti_orientation(image, oblique=oblique, name=name)
+    except ValueError as error:
+        raise _oblique_hint(error) from None
     data = orientations.apply_orientation(data, ornt)
     data = np.ascontiguousarray(data.transpose(2, 1, 0))  # (i, j, k) -> [z, y, x]
     return _volume(data, extent, spacing, origin, nan)

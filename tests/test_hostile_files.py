@@ -354,6 +354,21 @@ def test_vti_direction_is_applied(tmp_path):
     np.testing.assert_allclose(vol.origin, [-5.0, 0.0, 0.0])
 
 
+def test_mpi_sources_refuse_oblique_nifti_and_keep_byte_order(tmp_path):
+    """The MPI ranks' file reader turns NIfTI files as the loader does (oblique refused,
+    not dropped) and takes a raw dtype's byte order as the loader does."""
+    from vrlib.parallel.sources import RawFile, memory_map
+
+    turn = np.eye(4)
+    turn[:2, :2] = [[np.cos(0.3), -np.sin(0.3)], [np.sin(0.3), np.cos(0.3)]]
+    nibabel.save(nibabel.Nifti1Image(DATA.transpose(2, 1, 0), turn), tmp_path / "o.nii")
+    with pytest.raises(ValueError, match="source o.nii: its voxel axes are oblique"):
+        memory_map(tmp_path / "o.nii")
+    np.arange(8, dtype=">i2").tofile(tmp_path / "v.raw")
+    array, _, _ = memory_map(RawFile(tmp_path / "v.raw", (2, 2, 2), ">i2"))
+    assert int(array[1, 1, 1]) == 7
+
+
 def test_raw_dtype_names_its_byte_order(tmp_path):
     np.arange(8, dtype=">i2").tofile(tmp_path / "v.raw")
     vol = data_gen.load(tmp_path / "v.raw", shape=(2, 2, 2), dtype=">i2")

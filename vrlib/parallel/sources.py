@@ -70,7 +70,7 @@ class RawFile:
     shape: tuple
     dtype: str
     offset: int = 0
-    byteorder: str = "little"
+    byteorder: str | None = None  # default the one dtype names, else little
 
 
 def memory_map(source):
@@ -81,13 +81,13 @@ def memory_map(source):
     compressed NIfTI (which cannot be mapped) or an array that is not 3-D.
     """
     if isinstance(source, RawFile):
+        from data_gen.loaders import raw_dtype
+
         path = _file(source.path)
         shape = tuple(validate.positive_int("shape", n, minimum=2) for n in source.shape)
         if len(shape) != 3:
             raise ValueError(f"shape must be (nz, ny, nx), got {shape!r}")
-        validate.choice("byteorder", source.byteorder, ("little", "big"))
-        dtype = np.dtype(source.dtype).newbyteorder("<" if source.byteorder == "little"
-                                                    else ">")
+        dtype = raw_dtype(source.dtype, source.byteorder)
         offset = validate.positive_int("offset", source.offset, minimum=0)
         _check_size(path, offset + math.prod(shape) * dtype.itemsize, shape, dtype, offset)
         array = np.memmap(path, dtype=dtype, mode="r", offset=offset, shape=shape)
@@ -147,7 +147,11 @@ def _map_nifti(path):
         dtype, offset = np.dtype(proxy.dtype), int(proxy.offset)
         shape = tuple(int(n) for n in proxy.shape)
         slope, intercept = float(proxy.slope), float(proxy.inter)
-        ornt, spacing, origin = nifti_orientation(image)
+        ornt, spacing, origin = nifti_orientation(image, name=f"source {path.name}")
+    except ValueError as error:
+        if "oblique" in str(error) or "affine" in str(error):  # not a guess: refused
+            raise
+        raise ValueError(f"source {path.name} is not a readable NIfTI file: {error}") from None
     except Exception as error:  # nibabel raises many kinds on a corrupt header
         raise ValueError(f"source {path.name} is not a readable NIfTI file: {error}") from None
     if len(shape) == 4 and shape[3] == 1:
