@@ -14,6 +14,7 @@ import numpy as np
 from scipy import special
 
 from vrlib import validate
+from vrlib.transfer import Glow
 from vrlib.volume import DEFAULT_EXTENT, Volume, check_extent
 
 __all__ = [
@@ -117,7 +118,7 @@ class Field:
             raise ValueError(f"dtype must be float32 or float64, got {np.dtype(dtype)}")
         ext = check_extent(self.bounds if extent is None else extent)
         data = self.sample_region(shape, [(0, n) for n in shape], extent=ext, dtype=dtype)
-        return Volume(data, ext, copy=False)
+        return Volume(data, ext, copy=False, transfer=Glow(1.0))
 
     def sample_region(self, shape, region, *, extent=None, dtype=np.float64):
         """The samples ``region`` (``(start, stop)`` per axis, z, y, x) of the lattice that

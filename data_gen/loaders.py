@@ -77,14 +77,17 @@ def _unreadable(path, kind, error):
     return ValueError(f"{Path(path).name} is not a readable {kind} file: {text}")
 
 
-def _volume(data, extent, spacing, origin, nan):
-    """A volume with ``extent`` if given, else ``spacing`` and ``origin`` (defaults 1, 0)."""
+def _volume(data, extent, spacing, origin, nan, file_dtype=None):
+    """A volume with ``extent`` if given, else ``spacing`` and ``origin`` (defaults 1, 0);
+    ``file_dtype`` the file's sample type, default the type of ``data`` as read."""
+    file_dtype = np.asarray(data).dtype if file_dtype is None else file_dtype
     if np.asarray(data).dtype == np.bool_:  # a mask: 0 and 1
         data = np.asarray(data, dtype=np.uint8)
     if extent is not None:
-        return Volume(data, extent, nan=nan, copy=False)
+        return Volume(data, extent, nan=nan, copy=False, file_dtype=file_dtype)
     return Volume(data, spacing=(1.0, 1.0, 1.0) if spacing is None else spacing,
-                  origin=(0.0, 0.0, 0.0) if origin is None else origin, nan=nan, copy=False)
+                  origin=(0.0, 0.0, 0.0) if origin is None else origin, nan=nan, copy=False,
+                  file_dtype=file_dtype)
 
 
 def load_npy(path, *, spacing=None, origin=None, extent=None, nan="error"):
@@ -333,7 +336,7 @@ def nifti_volume(image, name, *, frame=None, extent=None, nan="error", oblique="
         raise _oblique_hint(error) from None
     data = orientations.apply_orientation(data, ornt)
     data = np.ascontiguousarray(data.transpose(2, 1, 0))  # (i, j, k) -> [z, y, x]
-    return _volume(data, extent, spacing, origin, nan)
+    return _volume(data, extent, spacing, origin, nan, image.get_data_dtype())
 
 
 def _frame(name, shape, frame):
@@ -658,7 +661,8 @@ def _stack_dicom(folder, members, extent, nan, oblique):
     for index in order:
         file, ds = members[index]
         try:
-            plane = ds.pixel_array.astype(np.float64)
+            stored = ds.pixel_array
+            plane = stored.astype(np.float64)
         except Exception as error:
             raise _unreadable(file, "DICOM", error) from None
         if planes and plane.shape != planes[0].shape:
@@ -669,10 +673,11 @@ def _stack_dicom(folder, members, extent, nan, oblique):
     data = np.stack(planes)
     first = members[order[0]][1]
     origin = np.asarray(first.ImagePositionPatient, dtype=np.float64)
-    return _dicom_volume(data, cosines, pixel, gap, origin, folder.name, extent, nan, oblique)
+    return _dicom_volume(data, cosines, pixel, gap, origin, folder.name, extent, nan, oblique,
+                         stored.dtype)
 
 
-def _dicom_volume(data, cosines, pixel, gap, origin, name, extent, nan, oblique):
+def _dicom_volume(data, cosines, pixel, gap, origin, name, extent, nan, oblique, file_dtype):
     """The volume of slices ``data[k, j, i]`` sorted along their normal: the rows' and
     columns' direction ``cosines``, ``pixel`` spacing (row, column), slice ``gap`` and first
     corner ``origin``, all in DICOM's patient coordinates (LPS), turned exactly to RAS as a
@@ -692,7 +697,7 @@ def _dicom_volume(data, cosines, pixel, gap, origin, name, extent, nan, oblique)
         data, spacing, origin = to_world_axes(data, directions, origin, name)
     except ValueError as error:
         raise _oblique_hint(error) from None
-    return _volume(data, extent, spacing, origin, nan)
+    return _volume(data, extent, spacing, origin, nan, file_dtype)
 
 
 def _oblique_hint(error):
@@ -764,7 +769,8 @@ def load_dicom_file(path, *, extent=None, nan="error", oblique="refuse"):
                          if "PixelValueTransformationSequence" in scale else {})
             scales.append((float(transform.get("RescaleSlope", 1.0)),
                            float(transform.get("RescaleIntercept", 0.0))))
-        pixels = ds.pixel_array.astype(np.float64)
+        stored = ds.pixel_array
+        pixels = stored.astype(np.float64)
     except ValueError:
         raise
     except Exception as error:  # pydicom raises many kinds on a corrupt or partial file
@@ -779,7 +785,7 @@ def load_dicom_file(path, *, extent=None, nan="error", oblique="refuse"):
     order, gap = _slice_order([float(np.dot(c, normal)) for c in corners], path.name)
     data = np.stack([pixels[i] * scales[i][0] + scales[i][1] for i in order])
     return _dicom_volume(data, cosines, pixel, gap, corners[order[0]], path.name, extent, nan,
-                         oblique)
+                         oblique, stored.dtype)
 
 
 # VolPack's .den header (Levoy's format): 28 shorts (version, then original, extracted and

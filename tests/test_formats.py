@@ -331,3 +331,35 @@ def test_anisotropic_voxels_in_every_method():
         assert vrlib.metrics.rmse(image, fine) < 0.02, method  # measured 1e-3 .. 1e-2
     cubic = vrlib.Volume(aniso.data, spacing=(4, 4, 4))
     assert vrlib.metrics.rmse(vrlib.render(cubic, view, transfer=transfer), fine) > 0.03  # 0.05
+
+
+def test_each_loader_names_the_files_sample_type(tmp_path):
+    """``Volume.file_dtype`` is the type the file stores (before any scaling), which
+    ``vrlib info`` prints beside the type held in memory."""
+    from vrlib.cli import describe_volume
+
+    big = DATA.astype(">i2")
+    np.save(tmp_path / "v.npy", big)
+    scaled = nibabel.Nifti1Image(np.ascontiguousarray(DATA.transpose(2, 1, 0)), np.eye(4))
+    scaled.header.set_slope_inter(0.5, 10.0)
+    nibabel.save(scaled, tmp_path / "v.nii")
+    nrrd.write(str(tmp_path / "v.nrrd"), DATA, index_order="C")
+    tifffile.imwrite(tmp_path / "v.tif", DATA.astype(np.uint16), imagej=True)
+    grid = pyvista.ImageData(dimensions=(6, 5, 4))
+    grid.point_data["v"] = DATA.ravel()
+    grid.save(tmp_path / "v.vti")
+    (tmp_path / "series").mkdir()
+    write_series(tmp_path / "series", DATA.astype(np.float64) * 2 - 1024, slope=2.0,
+                 intercept=-1024.0)
+    big.tofile(tmp_path / "v.raw")
+    found = {name: data_gen.load(tmp_path / name).file_dtype.name
+             for name in ("v.npy", "v.nii", "v.nrrd", "v.tif", "v.vti", "series")}
+    found["v.raw"] = data_gen.load(tmp_path / "v.raw", shape=DATA.shape,
+                                   dtype=">i2").file_dtype.name
+    assert found == {"v.npy": "int16", "v.nii": "int16", "v.nrrd": "int16", "v.tif": "uint16",
+                     "v.vti": "int16", "series": "int16", "v.raw": "int16"}
+    assert data_gen.load(tmp_path / "v.nii").dtype == np.float64  # scaled on reading
+    first = describe_volume(data_gen.load(tmp_path / "v.npy"))[0]
+    assert first == ("shape (z, y, x): (4, 5, 6), stored in the file as int16, big-endian, "
+                     "held in memory as float32")
+    assert "stored in the file" not in describe_volume(vrlib.Volume(DATA))[0]

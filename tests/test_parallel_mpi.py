@@ -373,6 +373,9 @@ def test_bad_arguments_name_the_parameter(tmp_path):
     data[2, 2, 2] = np.nan
     np.save(bad, data)
     with pytest.raises(ValueError, match="NaN or infinite"):
+        mpi.render_object(comm, bad, view, transfer=vrlib.Glow(1.0))
+    np.save(bad, np.zeros((5, 5, 5)))
+    with pytest.raises(ValueError, match="transfer is required for a file source"):
         mpi.render_object(comm, bad, view)
     with pytest.raises(ValueError, match="cannot split"):
         mpi.render_object(comm, field, view, shape=2, balance="interleaved",

@@ -104,3 +104,54 @@ def test_phong_factor():
 def test_bad_input(call, error, message):
     with pytest.raises(error, match=message):
         call()
+
+
+def _head():
+    """A stand-in for a scan: a ball of tissue (values near 100) in faint noise."""
+    rng = np.random.default_rng(5)
+    z, y, x = np.mgrid[-1:1:24j, -1:1:24j, -1:1:24j]
+    data = np.where(x * x + y * y + z * z < 0.6, 90.0 + 20.0 * rng.random((24,) * 3),
+                    5.0 * rng.random((24,) * 3))
+    return data
+
+
+def test_one_default_transfer_for_python_and_the_command_line(tmp_path):
+    """Real data rendered without a transfer function shows its inside (the ramp fitted to
+    its histogram), as the command line's default does; the analytic fields' samples keep
+    the thesis's Glow(1.0). Glow(1.0) on such data is the white silhouette the default
+    used to give."""
+    import argparse
+
+    import data_gen
+    import vrlib
+    from vrlib.cli import make_transfer
+
+    volume = vrlib.Volume(_head())
+    view = vrlib.View.orbit(azimuth=20, size=24)
+    shown = vrlib.render(volume, view)
+    np.testing.assert_array_equal(
+        shown.rgba, vrlib.render(volume, view, transfer=vrlib.auto_transfer(volume)).rgba)
+    glow = vrlib.render(volume, view, transfer=Glow(1.0)).alpha
+    covered = glow > 0.5
+    assert (glow[covered] > 0.99).mean() > 0.5  # measured 0.65: a silhouette
+    assert (shown.alpha[covered] > 0.99).mean() < 0.1  # measured 0
+    assert np.ptp(shown.composited()[covered]) > 0.5  # measured 0.89
+    # The command line builds the same function for a file.
+    np.save(tmp_path / "head.npy", _head())
+    loaded = data_gen.load(tmp_path / "head.npy")
+    options = argparse.Namespace(shade=False, cmap=None, labels=False, transfer=None,
+                                 opacity=None, clim=None)
+    cli = make_transfer(options, field=None)(loaded)
+    values = np.linspace(*loaded.value_range, 101)
+    default = vrlib.default_transfer(loaded)
+    np.testing.assert_array_equal(cli.opacity_density(values), default.opacity_density(values))
+    np.testing.assert_array_equal(cli.emission(values), default.emission(values))
+    # Fields keep Glow(1.0), in render and in classify.
+    blob = data_gen.make_field("gaussian-blob", sigma=0.4).sample(12)
+    assert repr(vrlib.default_transfer(blob)) == "Glow(1)"
+    np.testing.assert_array_equal(vrlib.render(blob, view).rgba,
+                                  vrlib.render(blob, view, transfer=Glow(1.0)).rgba)
+    assert repr(vrlib.classify(blob).transfer) == "Glow(1)"
+    assert vrlib.classify(volume).transfer is vrlib.default_transfer(volume)
+    with pytest.raises(TypeError, match="transfer must be None or a vrlib transfer function"):
+        vrlib.Volume(_head(), transfer="glow")

@@ -21,7 +21,7 @@ from vrlib import bounds, compositing, cost, filters, metrics, prefilter
 from vrlib.animation import turntable
 from vrlib.arguments import EmptyImageWarning
 from vrlib.classified import ClassifiedVolume, classify
-from vrlib.colormapping import auto_transfer, colormap, label_transfer
+from vrlib.colormapping import auto_transfer, colormap, default_transfer, label_transfer
 from vrlib.filters import FILTERS, make_filter
 from vrlib.image import Image, RenderStats
 from vrlib.reconstruction import ReconstructedField, reconstruct
@@ -49,6 +49,7 @@ __all__ = [
     "LookupTransfer",
     "colormap",
     "auto_transfer",
+    "default_transfer",
     "label_transfer",
     "Phong",
     "GradientOpacity",

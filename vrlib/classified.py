@@ -30,6 +30,7 @@ from vrlib._kernels.classified import composite_classified, shade_table
 from vrlib._kernels.shear import warp
 from vrlib._scheduling import balanced_order, thread_count
 from vrlib.arguments import check_transfer, framed_view
+from vrlib.colormapping import default_transfer
 from vrlib.filters import make_filter
 from vrlib.holes import with_holes
 from vrlib.image import Image, RenderStats
@@ -105,9 +106,10 @@ def classify(volume, transfer=None, *, min_opacity=0.0):
     Parameters
     ----------
     volume : Volume
-    transfer : TransferFunction, default ``Glow(1.0)``
+    transfer : TransferFunction, optional
         Any transfer function, shaded or not, with or without gradient opacity
-        (:class:`vrlib.GradientOpacity`).
+        (:class:`vrlib.GradientOpacity`); default :func:`vrlib.default_transfer`, as
+        :func:`vrlib.render`.
     min_opacity : float, default 0
         Voxels whose opacity over one voxel spacing along the slice axis is at most this are
         not stored (VolPack's ``VP_MIN_VOXEL_OPACITY``): 0 drops only voxels that add nothing
@@ -142,7 +144,7 @@ class ClassifiedVolume:
         if not isinstance(volume, Volume):
             raise TypeError(f"volume must be a vrlib.Volume, got {type(volume).__name__}")
         self.volume = volume
-        self.transfer = check_transfer(transfer)
+        self.transfer = check_transfer(default_transfer(volume) if transfer is None else transfer)
         self.min_opacity = validate.finite_number("min_opacity", min_opacity, low=0.0,
                                                   high=1.0, high_open=True)
         start = time.perf_counter()

@@ -499,6 +499,14 @@ def cmd_bench(args):
         print(f"{method:<10} {filt:<12} {seconds:8.4f} {rmse:10.2e}")
 
 
+def _type_name(dtype):
+    """A sample type as a user reads it: its name and, for multi-byte types, byte order."""
+    order = {">": ", big-endian", "<": ", little-endian"}.get(dtype.byteorder, "")
+    if dtype.byteorder == "=":
+        order = f", {sys.byteorder}-endian" if dtype.itemsize > 1 else ""
+    return f"{dtype.name}{order if dtype.itemsize > 1 else ''}"
+
+
 def describe_volume(volume):
     """Lines describing a volume for choosing a transfer function: shape, spacing, box, value
     range, percentiles and a text histogram."""
@@ -507,7 +515,9 @@ def describe_volume(volume):
     data = vrlib.colormapping.finite_values(volume)
     low, high = volume.value_range
     ext = " x ".join(f"[{a:g}, {b:g}]" for a, b in volume.extent)
-    lines = [f"shape (z, y, x): {volume.shape}, held in memory as {volume.dtype}",
+    stored = ("" if volume.file_dtype is None else
+              f"stored in the file as {_type_name(volume.file_dtype)}, ")
+    lines = [f"shape (z, y, x): {volume.shape}, {stored}held in memory as {volume.dtype}",
              f"spacing (x, y, z): {', '.join(f'{v:g}' for v in volume.spacing)}",
              f"world box: {ext}",
              f"values: {low:g} .. {high:g}"]

@@ -203,6 +203,27 @@ def auto_transfer(volume, cmap="gray", *, shading=None, peak_alpha=0.25):
                     shading=shading)
 
 
+def default_transfer(volume):
+    """The transfer function a render uses when it is given none: the volume's own
+    (:attr:`vrlib.Volume.transfer`; the analytic fields' samples carry ``Glow(1.0)``), else
+    :func:`auto_transfer` fitted to its histogram, built once and kept with the volume. The
+    command line follows the same rule.
+
+    Examples
+    --------
+    >>> import data_gen
+    >>> from vrlib import Volume
+    >>> default_transfer(data_gen.make_field("gaussian-blob").sample(8))
+    Glow(1)
+    >>> data = np.zeros((8, 8, 8)); data[2:6, 2:6, 2:6] = 100.0
+    >>> type(default_transfer(Volume(data))).__name__
+    'LookupTransfer'
+    """
+    if volume.transfer is not None:
+        return volume.transfer
+    return volume.cached(("auto_transfer",), lambda: auto_transfer(volume))
+
+
 def label_transfer(volume, *, colors=None, opacity=0.3, hidden=(0,), cmap="tab20",
                    unit_distance=None, shading=None):
     """One colour and one opacity per label of an integer label volume (segmentations, the

@@ -88,9 +88,9 @@ def measure(render, *, repeats=3, warmup=True):
     Examples
     --------
     >>> import numpy as np
-    >>> from vrlib import Volume, View, render as draw
+    >>> from vrlib import Glow, Volume, View, render as draw
     >>> vol, view = Volume(np.ones((4, 4, 4))), View.orbit(size=8)
-    >>> seconds, image = measure(lambda: draw(vol, view), repeats=2)
+    >>> seconds, image = measure(lambda: draw(vol, view, transfer=Glow(1.0)), repeats=2)
     >>> seconds > 0 and image.stats.samples > 0
     True
     """

@@ -7,7 +7,7 @@ import inspect
 from vrlib import validate
 from vrlib._scheduling import thread_count
 from vrlib.arguments import framed_view, refuse_gradients, render_arguments
-from vrlib.colormapping import auto_transfer
+from vrlib.colormapping import auto_transfer, default_transfer
 from vrlib.holes import with_holes
 from vrlib.projection import BLENDS, render_projection
 from vrlib.raycast import render_raycast
@@ -65,10 +65,12 @@ def render(volume, view, *, method="raycast", filter="trilinear", transfer=None,
         filter (``"cardinal-bspline"``, ``"omoms"``) reconstructs spline coefficients with its
         kernel, in every method (:mod:`vrlib.prefilter` says which axes each prefilters; the
         volume's coefficients are kept with it); ``stats.prefilter`` says what it cost.
-    transfer : TransferFunction or "auto", default ``Glow(1.0)``
+    transfer : TransferFunction or "auto", optional
         ``"auto"`` fits a grey ramp to the volume's histogram (:func:`vrlib.auto_transfer`),
         for real data; ``Glow(1.0)`` (density = value per world unit) is the thesis's study
-        function for the analytic fields. Build others with :func:`vrlib.colormap`.
+        function for the analytic fields. Build others with :func:`vrlib.colormap`. Default:
+        :func:`vrlib.default_transfer`, the volume's own (``Glow(1.0)`` for the analytic
+        fields' samples), else ``"auto"``, as on the command line.
     step : float, default 0.5
         Sample spacing along each ray, in voxels (of the smallest spacing); > 0. Opacity is
         computed per segment as ``1 - exp(-density * step)``, so images converge as the step
@@ -122,7 +124,9 @@ def render(volume, view, *, method="raycast", filter="trilinear", transfer=None,
                 if type(volume).__name__ == "ClassifiedVolume" else "")
         raise TypeError(f"volume must be a vrlib.Volume, got {type(volume).__name__}{hint}")
     validate.choice("method", method, (*METHODS, "auto"))
-    if isinstance(transfer, str) and transfer == "auto":
+    if transfer is None:
+        transfer = default_transfer(volume)
+    elif isinstance(transfer, str) and transfer == "auto":
         transfer = auto_transfer(volume)
     if tolerance is not None:
         _check_tolerance_arguments(method, step, early_termination, blend, options)

@@ -38,10 +38,11 @@ def storage_dtype(dtype):
 
     Examples
     --------
-    >>> storage_dtype("uint16"), storage_dtype("int32")
-    (dtype('float32'), dtype('float64'))
+    >>> storage_dtype("uint16"), storage_dtype(">i2"), storage_dtype("int32")
+    (dtype('float32'), dtype('float32'), dtype('float64'))
     """
-    return np.dtype(np.float32 if np.dtype(dtype) in _EXACT_IN_FLOAT32 else np.float64)
+    native = np.dtype(dtype).newbyteorder("=")  # a big-endian file's int16 is an int16
+    return np.dtype(np.float32 if native in _EXACT_IN_FLOAT32 else np.float64)
 
 
 @dataclass(frozen=True)
@@ -112,6 +113,13 @@ class Volume:
     copy : bool, default True
         Copy ``data``. With ``copy=False`` an array that already has the storage type is used
         as is (read-only view): do not modify it afterwards.
+    file_dtype : numpy dtype, optional
+        The sample type of the file the samples were read from (:attr:`file_dtype`; the
+        loaders of ``data_gen`` set it).
+    transfer : TransferFunction, optional
+        The transfer function renders use when they are given none (:attr:`transfer`). The
+        analytic fields' samples carry ``Glow(1.0)``, the thesis's study function; without
+        one, renders fit :func:`vrlib.auto_transfer` to the histogram, which shows real data.
 
     Notes
     -----
@@ -144,7 +152,14 @@ class Volume:
     """
 
     def __init__(self, data, extent=None, *, spacing=None, origin=None, nan="error",
-                 copy=True):
+                 copy=True, file_dtype=None, transfer=None):
+        from vrlib.transfer import TransferFunction
+
+        if transfer is not None and not isinstance(transfer, TransferFunction):
+            raise TypeError(f"transfer must be None or a vrlib transfer function (Glow, "
+                            f"LookupTransfer), got {transfer!r}")
+        self._transfer = transfer
+        self._file_dtype = None if file_dtype is None else np.dtype(file_dtype)
         arr = np.asarray(data)
         if arr.dtype.kind not in "iuf":
             raise TypeError(
@@ -194,6 +209,18 @@ class Volume:
         self._derived = {}  # cached structures built from the samples (pyramids, runs)
 
     # -- lattice geometry ------------------------------------------------------------------
+
+    @property
+    def transfer(self):
+        """The transfer function renders use when they are given none, or None: then they use
+        :func:`vrlib.default_transfer`'s histogram fit."""
+        return self._transfer
+
+    @property
+    def file_dtype(self):
+        """The sample type of the file the samples were read from (before any scaling), or
+        None for a volume made from an array; :attr:`dtype` is the type held in memory."""
+        return self._file_dtype
 
     @property
     def data(self):

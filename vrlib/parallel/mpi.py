@@ -108,6 +108,17 @@ def _root(root, size):
     return root
 
 
+def _refuse_default_transfer(source, given):
+    """A file rendered without a transfer function: the serial default
+    (:func:`vrlib.default_transfer`) fits a ramp to the whole volume's histogram, which no
+    rank holds, and Glow(1.0) would not show real data. Refuse rather than guess."""
+    if not given and not callable(getattr(source, "sample_region", None)):
+        raise ValueError("transfer is required for a file source: vrlib.render's default fits "
+                         "a ramp to the whole volume's histogram, which no rank holds; pass "
+                         "one, e.g. vrlib.colormap('gray', [(0, 0), (1, 0.25)], clim=(LOW, "
+                         "HIGH)) or vrlib.auto_transfer(data_gen.load(path))")
+
+
 def _check(view, filter, transfer, step, compositing=None, balance=None,
            bricks_per_rank=1):
     filt, transfer, step, _ = render_arguments(view, filter, transfer, step)
@@ -146,7 +157,8 @@ def render_object(comm, source, view, *, shape=None, extent=None, filter="trilin
     filter, transfer, step
         As :func:`vrlib.render` (ray casting; shading and gradient opacity included). Early ray
         termination is off, so the image equals the serial render's with
-        ``early_termination=1``.
+        ``early_termination=1``. ``transfer`` defaults to ``Glow(1.0)`` for a field, as its
+        serial samples carry; a file needs one (the serial default fits the whole histogram).
     compositing : str or Compositor, default "binary-swap"
         A name from :data:`vrlib.parallel.composite.COMPOSITORS` ("binary-swap",
         "direct-send", "radix-k"), ``"radix-k:2x3"`` or ``RadixK([2, 3])`` (radix-k with the
@@ -186,11 +198,13 @@ def render_object(comm, source, view, *, shape=None, extent=None, filter="trilin
     """
     size, rank = comm.Get_size(), comm.Get_rank()
     sent = {"balance": 0, "voxels": 0, "composite": 0, "gather": 0}
+    transfer_given = transfer is not None
     with Stage(comm, "checking the arguments"):
         filt, transfer, step, compositor = _check(view, filter, transfer, step, compositing,
                                                   balance, bricks_per_rank)
         root = _root(root, size)
         lattice, read = open_source(source, shape, extent)
+        _refuse_default_transfer(source, transfer_given)
         view = view.fitted(lattice.extent)
         if balance == "interleaved":
             tree = split(lattice.cells, size * bricks_per_rank)
@@ -298,11 +312,13 @@ def render_image(comm, source, view, *, shape=None, extent=None, filter="triline
     """
     size, rank = comm.Get_size(), comm.Get_rank()
     sent = {"balance": 0, "voxels": 0, "composite": 0, "gather": 0}
+    transfer_given = transfer is not None
     with Stage(comm, "checking the arguments"):
         filt, transfer, step, _ = _check(view, filter, transfer, step)
         validate.choice("layout", layout, ("contiguous", "interleaved"))
         root = _root(root, size)
         lattice, read = open_source(source, shape, extent)
+        _refuse_default_transfer(source, transfer_given)
         view = view.fitted(lattice.extent)
         tree = split(lattice.cells, size)
         tiles = screen_tiles(view.height, view.width, size, layout=layout, tile=tile)
