@@ -286,7 +286,8 @@ def _check_nifti_size(image, path):
     try:
         shape = tuple(int(n) for n in image.shape)
         dtype = np.dtype(header.get_data_dtype())
-        offset = int(header.get_data_offset())
+        # the loaded image's header is a copy with its offset reset; the data's proxy keeps it
+        offset = int(getattr(image.dataobj, "offset", header.get_data_offset()))
     except Exception as error:
         raise _unreadable(path, "NIfTI", error) from None
     if len(shape) < 3 or min(shape) < 1 or offset < 0:

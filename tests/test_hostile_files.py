@@ -104,7 +104,7 @@ def build_cases(root):
             den_header.tobytes() + np.array([64], ">i4").tobytes())
     cases["den-sparse-3gb"] = (info(folder / "big.den"), "truncated?")
     cases["nifti-claims-32767"] = (info(_nifti_header(folder / "n1.nii", (32767,) * 3)),
-                                   "truncated?")
+                                   "after 352 header bytes): truncated?")
     gz = folder / "n3.nii.gz"
     gz.write_bytes(gzip.compress(_nifti_header(folder / "n3.nii", (32767,) * 3).read_bytes()))
     cases["nifti-gz-claims-32767"] = (info(gz), "GB in memory")
