@@ -18,7 +18,7 @@ import numpy as np
 from vrlib import validate
 from vrlib._kernels import raycast as _kernel
 from vrlib._kernels.filters import TENT
-from vrlib._scheduling import balanced_order
+from vrlib._scheduling import balanced_runs, run_in_threads
 from vrlib.adaptive import step_multipliers
 from vrlib.image import Image, RenderStats
 from vrlib.prefilter import Tally, prepared
@@ -267,24 +267,38 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
     padded = np.zeros((rows * TILE[0], cols * TILE[1]))
     padded[: view.height, : view.width] = mask + 0.05
     costs = padded.reshape(rows, TILE[0], cols, TILE[1]).sum(axis=(1, 3)).ravel()
-    layout = (data, np.asarray(offset, np.int64), np.asarray(global_shape, np.int64),
-              np.asarray(origin, np.float64), np.asarray(spacing, np.float64),
-              np.asarray(box[0], np.float64), np.asarray(box[1], np.float64),
+    # One array type per argument (read-only samples, contiguous vectors): every other
+    # combination would compile the kernel once more.
+    readonly = data.view()
+    readonly.flags.writeable = False
+    vector = np.ascontiguousarray
+    layout = (readonly, vector(offset, np.int64), vector(global_shape, np.int64),
+              vector(origin, np.float64), vector(spacing, np.float64),
+              vector(box[0], np.float64), vector(box[1], np.float64),
               *lattice_extent(global_shape, spacing, origin).T.copy())
     skips = (early_termination, *skip, np.zeros((1, 1, 1)) if bound is None else bound,
              float(budget))
-    tiles = (*TILE, balanced_order(costs, numba.get_num_threads()), out, samples)
+    runs = balanced_runs(costs, numba.get_num_threads())
     if preintegrated:
         profile = "step" if filt.radius <= 0.5 else "linear"  # the box filter jumps
+        table = transfer.preintegrated_table(ds, *value_range, profile=profile)
         _kernel.raycast_preintegrated(
             *layout, view.packed(), view.height, view.width, ds, *filt.code, filt.radius,
-            filt.taps, *transfer.preintegrated_table(ds, *value_range, profile=profile),
-            *lighting, *by_gradient, *skips, *tiles)
+            filt.taps, *table, *lighting, *by_gradient, *skips, *TILE, np.concatenate(runs),
+            out, samples)
     else:
         grey = shading is None and bool(np.all(tables[4] == 1.0))  # colour equals opacity
-        _kernel.raycast(
-            *layout, bool(exact_ends), view.packed(), view.height, view.width, ds,
-            *filt.code, filt.radius, filt.taps, *tables, *lighting, *by_gradient, *skips,
-            np.ones((1, 1, 1), np.int64) if multiplier is None else multiplier, *tiles, grey)
+        multiplier = np.ones((1, 1, 1), np.int64) if multiplier is None else multiplier
+        arguments = (*layout, bool(exact_ends), view.packed(), view.height, view.width, ds,
+                     *filt.code, filt.radius, filt.taps, *tables, *lighting, *by_gradient,
+                     *skips, multiplier, *TILE)
+        if filt.code[0] == TENT and shading is None and ramp is None:
+            # A kernel of its own, compiled in half the time (a first render's wait), its
+            # runs of tiles on Python threads.
+            skipping = None if skip[2] == 0 else True
+            run_in_threads(lambda run: _kernel.raycast(*arguments, run, out, samples, grey,
+                                                       None, skipping), runs)
+        else:
+            _kernel.raycast_parallel(*arguments, np.concatenate(runs), out, samples, grey)
     np.clip(out[..., 3], 0.0, 1.0, out=out[..., 3])
     return out, int(samples.sum())
