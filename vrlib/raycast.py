@@ -17,6 +17,7 @@ import numpy as np
 
 from vrlib import validate
 from vrlib._kernels import raycast as _kernel
+from vrlib._kernels._jit import readonly
 from vrlib._kernels.filters import TENT
 from vrlib._scheduling import balanced_runs, run_in_threads
 from vrlib.adaptive import step_multipliers
@@ -269,10 +270,8 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
     costs = padded.reshape(rows, TILE[0], cols, TILE[1]).sum(axis=(1, 3)).ravel()
     # One array type per argument (read-only samples, contiguous vectors): every other
     # combination would compile the kernel once more.
-    readonly = data.view()
-    readonly.flags.writeable = False
     vector = np.ascontiguousarray
-    layout = (readonly, vector(offset, np.int64), vector(global_shape, np.int64),
+    layout = (readonly(data), vector(offset, np.int64), vector(global_shape, np.int64),
               vector(origin, np.float64), vector(spacing, np.float64),
               vector(box[0], np.float64), vector(box[1], np.float64),
               *lattice_extent(global_shape, spacing, origin).T.copy())

@@ -32,6 +32,7 @@ import numpy as np
 
 from vrlib import validate
 from vrlib._kernels import shear as _kernel
+from vrlib._kernels._jit import readonly
 from vrlib.gradients import kernel_lighting, no_gradients
 from vrlib.image import Image, RenderStats
 from vrlib.prefilter import Tally, filter_lines, prepared, prepared_gradients
@@ -159,7 +160,7 @@ def _run_pass(src, out, c0, c1, c2, offset, lo, hi, filt):
     counts = np.zeros(out.shape[0], np.int64)
     first = np.empty(out.shape[:2], np.int64)
     last = np.empty(out.shape[:2], np.int64)
-    _kernel.shear_pass(src, out, c0, c1, c2, offset, np.ascontiguousarray(lo),
+    _kernel.shear_pass(readonly(src), out, c0, c1, c2, offset, np.ascontiguousarray(lo),
                        np.ascontiguousarray(hi), *filt.code, filt.radius, filt.taps, across,
                        counts, first, last)
     if swap:

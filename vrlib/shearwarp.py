@@ -22,6 +22,7 @@ import numpy as np
 
 from vrlib import validate
 from vrlib._kernels import shear as _kernel
+from vrlib._kernels._jit import readonly
 from vrlib.arguments import refuse_gradients
 from vrlib.gradients import kernel_lighting, no_gradients
 from vrlib.image import Image, RenderStats
@@ -191,7 +192,7 @@ def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
             {2: (0, 1, 2, 3), 1: (0, 2, 1, 3), 0: (0, 3, 1, 2)}[axis])
     _kernel.shear_slices(slices, order, scale, di, dj, fraction, *filt.code, filt.radius,
                          ntaps, *tables, grads, *kernel_lighting(transfer, view.forward),
-                         early_termination, first, last, inter, counts)
+                         early_termination, readonly(first), readonly(last), inter, counts)
     # The warp: where each pixel's ray meets the front slice, in intermediate coordinates.
     plane = volume.origin[axis] + kf * h[axis]
     out = np.empty(view.shape + (4,))

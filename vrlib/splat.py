@@ -43,6 +43,7 @@ import numpy as np
 
 from vrlib import validate
 from vrlib._kernels import splat as _kernel
+from vrlib._kernels._jit import readonly
 from vrlib._scheduling import balanced_order
 from vrlib.arguments import refuse_gradients
 from vrlib.footprint import RADIAL, footprint, running_integral, slanted
@@ -188,7 +189,7 @@ def row_extents(volume, axis, marks):
     shape = _slice_order(marks, axis).shape[:2]
     first = np.empty(shape, np.int64)
     last = np.empty(shape, np.int64)
-    _kernel.row_extents(marks, axis, first, last)
+    _kernel.row_extents(readonly(np.asarray(marks)), axis, first, last)
     return first, last
 
 
@@ -302,7 +303,7 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
     pixels = np.zeros(bands, np.int64)
     dummy1, dummy2, dummy3 = np.zeros(2), np.zeros((2, 2)), np.zeros((2, 2, 2))
     _kernel.splat(
-        volume.data if mode == "direct" else marks, volume.origin, spacing, view.packed(),
+        readonly(volume.data if mode == "direct" else marks), volume.origin, spacing, view.packed(),
         view.height, view.width, axis, slices, ghost, float(filt.radius),
         running_integral(filt), fp.kind, fp.extent, fp.extent_v or fp.extent, fp.extent_s,
         fp.sigma, fp.table if fp.kind == RADIAL else dummy1,

@@ -25,3 +25,12 @@ parallel_jit = functools.partial(
     numba.njit, cache=True, nogil=True, error_model="numpy", parallel=True
 )
 """Kernel decorator for loops over independent work (``numba.prange``)."""
+
+
+def readonly(array):
+    """A read-only view of ``array``: numba compiles a kernel once per argument type, and an
+    array that is sometimes writable, sometimes not, would compile it twice over. Kernels
+    take their inputs through this."""
+    view = array.view()
+    view.flags.writeable = False
+    return view
