@@ -296,7 +296,7 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
     first, last = row_extents(volume, axis, marks) if (
         empty_space_skipping) else full_extents(volume, axis)
     slices = np.arange(-ghost, volume.shape[2 - axis] + ghost)
-    slices = slices if ascending else slices[::-1]
+    slices = slices if ascending else np.ascontiguousarray(slices[::-1])  # one array type
     bands = -(-view.height // BAND)
     out = np.zeros(view.shape + (4,))
     voxels = np.zeros(bands, np.int64)
