@@ -106,8 +106,8 @@ def main():
             caster.close()
             meeting = [s for s in settings if s["error"] <= peer_error]
             best = min(meeting, key=lambda s: s["seconds"]) if meeting else None
-            tol_s, tol_img = best_of(lambda e=peer_error: vrlib.render(
-                volume, view, transfer=transfer, tolerance=e, threads=2), repeats=2)
+            tol_s, tol_img = best_of(lambda e=peer_error, v=volume, t=transfer: vrlib.render(
+                v, view, transfer=t, tolerance=e, threads=2), repeats=2)
             tol_error = rgb_error(tol_img.rgba[..., :3], fine)
             scene["peers"][peer] = {"seconds": peer_s, "error": peer_error, "best": best,
                                     "tolerance_seconds": tol_s, "tolerance_error": tol_error}

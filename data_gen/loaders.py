@@ -454,7 +454,6 @@ def load_vtk(path, *, scalars=None, extent=None, nan="error"):
     [[1.0, 2.5], [0.0, 2.0], [0.0, 2.0]]
     """
     import pyvista
-
     from pyvista.core.utilities.observers import VtkErrorCatcher
 
     path = _existing(path)
@@ -545,10 +544,10 @@ def _check_vtk_claims(path):
             extent = [int(v) for v in found.group(1).split()]
         except ValueError:
             extent = []
-        if len(extent) != 6 or any(b < a for a, b in zip(extent[::2], extent[1::2])):
+        if len(extent) != 6 or any(b < a for a, b in zip(extent[::2], extent[1::2], strict=True)):
             raise ValueError(f"{path.name} is not a readable VTK file: WholeExtent "
                              f"{found.group(1).decode('latin-1')!r}")
-        count = math.prod(b - a + 1 for a, b in zip(extent[::2], extent[1::2]))
+        count = math.prod(b - a + 1 for a, b in zip(extent[::2], extent[1::2], strict=True))
         check_allocation(count, np.float64, path.name)
         # VTK reads a spacing or origin it cannot parse ("nan", "inf") as 1 or 0.
         for name, size in ((b"Spacing", 3), (b"Origin", 3), (b"Direction", 9)):

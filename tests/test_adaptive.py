@@ -4,10 +4,10 @@ checked against the by-the-book twin, across bricks and threads, and against the
 import numba
 import numpy as np
 import pytest
+from naive import raycast_naive
 
 import data_gen
 import vrlib
-from naive import raycast_naive
 from vrlib import Glow, LookupTransfer, Phong, View, render
 from vrlib.adaptive import block_differences, gradient_bounds, step_multipliers
 from vrlib.raycast import brightest, cast_rays

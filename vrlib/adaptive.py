@@ -93,7 +93,7 @@ def _block_max(arr, block, margin, shape, front=0):
     last sample are 0, the border extends; ``front`` of them before the first, so that a
     second difference sits at its middle sample) over each block of ``block`` cells (both
     end samples) widened by ``margin`` samples each side."""
-    widths = [(0, n - m) for n, m in zip(shape, arr.shape)]
+    widths = [(0, n - m) for n, m in zip(shape, arr.shape, strict=True)]
     widths = [(front, w[1] - front) if w[1] else w for w in widths]
     return block_extremes(np.pad(arr, widths), block, np.max, margin=margin)
 
@@ -145,7 +145,7 @@ def gradient_bounds(volume, filt, *, block=8):
     p, r, a = derivative_sums(filt)
     diffs = block_differences(volume, block=block, margin=filt.margin)
     squares = 0.0
-    for first, spacing in zip(diffs.first, volume.spacing):
+    for first, spacing in zip(diffs.first, volume.spacing, strict=True):
         along = (diffs.absolute * r + first * p) * a * a / spacing
         squares = squares + along * along
     return np.sqrt(squares)
@@ -156,10 +156,11 @@ def _bend_bounds(volume, block):
     stretch ``H`` of any ray (module docstring; per world unit)."""
     diffs = block_differences(volume, block=block)
     s = volume.spacing
-    axis = np.max([d / (h * h) for d, h in zip(diffs.second, s)], axis=0)
-    mixed = np.max([d / (s[i] * s[j])
-                    for d, (i, j) in zip(diffs.mixed, ((0, 1), (0, 2), (1, 2)))], axis=0)
-    kink = np.max([d / h for d, h in zip(diffs.second, s)], axis=0)
+    axis = np.max([d / (h * h) for d, h in zip(diffs.second, s, strict=True)], axis=0)
+    pairs = ((0, 1), (0, 2), (1, 2))
+    mixed = np.max([d / (s[i] * s[j]) for d, (i, j) in zip(diffs.mixed, pairs, strict=True)],
+                   axis=0)
+    kink = np.max([d / h for d, h in zip(diffs.second, s, strict=True)], axis=0)
     return axis + 2.0 * mixed, kink
 
 

@@ -303,8 +303,8 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
     pixels = np.zeros(bands, np.int64)
     dummy1, dummy2, dummy3 = np.zeros(2), np.zeros((2, 2)), np.zeros((2, 2, 2))
     _kernel.splat(
-        readonly(volume.data if mode == "direct" else marks), volume.origin, spacing, view.packed(),
-        view.height, view.width, axis, slices, ghost, float(filt.radius),
+        readonly(volume.data if mode == "direct" else marks), volume.origin, spacing,
+        view.packed(), view.height, view.width, axis, slices, ghost, float(filt.radius),
         running_integral(filt), fp.kind, fp.extent, fp.extent_v or fp.extent, fp.extent_s,
         fp.sigma, fp.table if fp.kind == RADIAL else dummy1,
         fp.table if fp.kind != RADIAL else dummy2, fp.partial if fp.kind != RADIAL else dummy3,
