@@ -74,10 +74,19 @@ def reconstruct_naive(volume, filt, points_index, *, gradient=False):
     """Separable reconstruction at index positions ``(n, 3)`` (x, y, z), edge-clamped.
 
     With ``gradient`` also returns ``(n, 3)`` derivatives in index units (one axis's weights
-    replaced by the kernel's derivative).
+    replaced by the kernel's derivative; for the box filter, whose derivative is zero,
+    :func:`numpy.gradient` of the samples at the nearest sample).
     """
     data = np.asarray(volume.data, dtype=np.float64)
     nz, ny, nx = data.shape
+    if gradient and filt.name == "box":
+        sampled = [np.gradient(data, axis=a) if data.shape[a] > 1 else np.zeros_like(data)
+                   for a in (2, 1, 0)]
+        nearest = np.floor(np.asarray(points_index, dtype=np.float64) + 0.5).astype(int)
+        nearest = np.clip(nearest, 0, [nx - 1, ny - 1, nz - 1])
+        values = reconstruct_naive(volume, filt, points_index)
+        ix, iy, iz = nearest.T
+        return values, np.stack([g[iz, iy, ix] for g in sampled], axis=1)
     r = filt.radius
     out = np.zeros(len(points_index))
     grad = np.zeros((len(points_index), 3))

@@ -38,6 +38,27 @@ def test_kernel_matches_naive_twin(projection, filt, transfer):
     assert fast.alpha.max() > 0.1
 
 
+
+def test_box_filter_shades_by_the_sampled_gradient():
+    """The box filter's derivative is zero, so shading by it drew the unshaded image,
+    silently (the README's ``--labels --shade`` frog). It now takes the samples' gradient at
+    the nearest sample (numpy.gradient's differences), as the shear methods do: the shaded
+    image differs from the unshaded one, and a light along the view lights the middle of a
+    ball more than a light across it (the twin tests above check the gradient itself)."""
+    labels = data_gen.make_field("smooth-sphere", radius=0.6).sample(24).data > 0.5
+    vol = Volume(labels.astype(float))
+    view = View.orbit(azimuth=0, elevation=0, size=32)  # looking along -x, y to the right
+
+    def red(transfer):
+        return render(vol, view, filter="box", transfer=transfer).rgba[..., 0]
+
+    along = red(LookupTransfer([0.0, 40.0], shading=Phong(light=(1, 0, 0), ambient=0.1)))
+    across = red(LookupTransfer([0.0, 40.0], shading=Phong(light=(0, 1, 0), ambient=0.1)))
+    unshaded = red(LookupTransfer([0.0, 40.0]))
+    assert np.abs(along - unshaded).max() > 0.1
+    middle = (slice(14, 18), slice(14, 18))
+    assert along[middle].mean() > 1.5 * across[middle].mean()
+
 @pytest.mark.parametrize("projection", ["orthographic", "perspective"])
 @pytest.mark.parametrize("filt", ["box", "trilinear", "catmull-rom", "gaussian"])
 @pytest.mark.parametrize("transfer", [Glow(3.0), TABLE, Glow(2.0, shading=Phong(specular=0.4))],

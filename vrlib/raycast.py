@@ -81,6 +81,10 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
     segment (a step at its middle with the box filter); gradient opacity and shading use the
     gradient at the segment's middle (docs/kernel.md).
 
+    Shading and gradient opacity differentiate the filter; the box filter, whose derivative
+    is zero, takes the samples' gradient (central differences, :func:`numpy.gradient`) at the
+    sample it reconstructs, as the methods that resample in passes do.
+
     ``skip_budget`` (>= 0, premultiplied colour units) lets each ray leave out blocks that
     are not empty, while the most those blocks could change any channel of its pixel
     (:func:`skip_bounds`) adds up to at most the budget; 0 skips only empty blocks.

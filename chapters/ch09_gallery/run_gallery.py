@@ -50,8 +50,8 @@ def colour_scenes():
                           shading=shaded)
     warm = vrlib.colormap("magma", [(0, 0), (0.25, 0), (0.45, 0.05), (1, 0.6)], volume=mni,
                           shading=shaded)
-    # Unshaded: a box filter's derivative is zero, so the ray caster would light every label
-    # sample as facing the light while the other methods shade central differences.
+    # Unshaded: flat colours show each label's extent. (Shaded, every method lights labels by
+    # the samples' central differences, the ray caster's box filter included.)
     labels = vrlib.label_transfer(frog, opacity={1: 0.02})
     return {
         "MNI152, bone colormap, shaded": (mni, "catmull-rom", bone, {"azimuth": 120.0}),

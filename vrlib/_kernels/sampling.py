@@ -15,6 +15,7 @@ import numpy as np
 
 from vrlib._kernels._jit import jit
 from vrlib._kernels.filters import (
+    BOX,
     GAUSSIAN,
     MAX_TAPS,
     cubic_coefficients,
@@ -225,8 +226,12 @@ def gradient(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1, fp2, radius, nta
     """Gradient of the reconstruction, ``(dF/dux, dF/duy, dF/duz)`` in index units.
 
     The derivative of the separable sum: one axis's weights replaced by the kernel's
-    derivative. ``dx, dy, dz`` are scratch arrays like ``wx``.
+    derivative. ``dx, dy, dz`` are scratch arrays like ``wx``. The box filter's derivative
+    is zero, so it takes the sampled gradient instead (:func:`sampled_gradient`), as the
+    other methods and VTK's nearest-sample interpolation do.
     """
+    if fkind == BOX:
+        return sampled_gradient(data, offset, gshape, ux, uy, uz)
     fx = filter_taps(fkind, fp0, fp1, fp2, radius, ntaps, ux, wx, dx)
     fy = filter_taps(fkind, fp0, fp1, fp2, radius, ntaps, uy, wy, dy)
     fz = filter_taps(fkind, fp0, fp1, fp2, radius, ntaps, uz, wz, dz)
@@ -246,4 +251,27 @@ def gradient(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1, fp2, radius, nta
             gx += wz[c] * wy[b] * drow
             gy += wz[c] * dy[b] * row
             gz += dz[c] * wy[b] * row
+    return gx, gy, gz
+
+
+@jit
+def sampled_gradient(data, offset, gshape, ux, uy, uz):
+    """The samples' gradient at the sample the box filter takes at ``(ux, uy, uz)`` (the
+    nearest, ``floor(u + 1/2)``, clamped to the volume), in index units: central differences
+    inside, one-sided on the volume's faces, as :func:`numpy.gradient` (and
+    :func:`vrlib.gradients.gradient_volumes`) compute them. A brick needs one ghost sample."""
+    i = clamp(int(math.floor(ux + 0.5)), gshape[2])
+    j = clamp(int(math.floor(uy + 0.5)), gshape[1])
+    k = clamp(int(math.floor(uz + 0.5)), gshape[0])
+    z, y, x = k - offset[0], j - offset[1], i - offset[2]
+    gx = gy = gz = 0.0
+    if gshape[2] > 1:
+        lo, hi = max(i - 1, 0) - offset[2], min(i + 1, gshape[2] - 1) - offset[2]
+        gx = (data[z, y, hi] - data[z, y, lo]) / (hi - lo)
+    if gshape[1] > 1:
+        lo, hi = max(j - 1, 0) - offset[1], min(j + 1, gshape[1] - 1) - offset[1]
+        gy = (data[z, hi, x] - data[z, lo, x]) / (hi - lo)
+    if gshape[0] > 1:
+        lo, hi = max(k - 1, 0) - offset[0], min(k + 1, gshape[0] - 1) - offset[0]
+        gz = (data[hi, y, x] - data[lo, y, x]) / (hi - lo)
     return gx, gy, gz
