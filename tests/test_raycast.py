@@ -11,6 +11,7 @@ from naive import exact_blob_image, image_mass, random_orbits, raycast_naive
 import data_gen
 import vrlib
 from vrlib import Glow, LookupTransfer, Phong, View, Volume, metrics, render, render_reference
+from vrlib.parallel.sources import ghost as ghost_samples
 from vrlib.raycast import cast_rays
 from vrlib.value_bounds import reconstructed_range
 
@@ -243,16 +244,20 @@ def test_early_termination_stays_within_its_bound():
 
 
 @pytest.mark.parametrize("ends", ["lattice", "exact"])
-def test_bricks_share_the_global_lattice(ends):
-    """Two bricks (with ghost samples), each rendered over its own box and composited with
-    the over operator, give the whole volume's image: no sample is taken twice or missed
-    (with exact ends, only the whole volume's faces cut a segment, never the bricks')."""
+@pytest.mark.parametrize("filt,transfer", [("catmull-rom", Glow(1.0)),
+                                           ("box", Glow(1.0, shading=Phong()))],
+                         ids=["catmull-rom", "box-shaded"])
+def test_bricks_share_the_global_lattice(ends, filt, transfer):
+    """Two bricks (with the ghost samples an MPI rank reads), each rendered over its own box
+    and composited with the over operator, give the whole volume's image: no sample is taken
+    twice or missed (with exact ends, only the whole volume's faces cut a segment, never the
+    bricks'); the box filter's sampled gradient needs its one ghost sample."""
     vol = data_gen.make_field("marschner-lobb").sample((20, 21, 22))
     view = View.orbit(azimuth=-70, elevation=25, size=30)
-    filt = vrlib.make_filter("catmull-rom")
-    whole = render(vol, view, filter=filt, step=0.41, early_termination=1.0,
-                   empty_space_skipping=False, segment_ends=ends)
-    split, ghost = 10, 2
+    filt = vrlib.make_filter(filt)
+    whole = render(vol, view, filter=filt, transfer=transfer, step=0.41,
+                   early_termination=1.0, empty_space_skipping=False, segment_ends=ends)
+    split, ghost = 10, ghost_samples(filt)
     ext = vol.extent
     z_cut = ext[2, 0] + split * vol.spacing[2]
     parts = []
@@ -262,7 +267,7 @@ def test_bricks_share_the_global_lattice(ends):
             np.ascontiguousarray(vol.data[first:stop]), offset=(first, 0, 0),
             global_shape=vol.shape, origin=vol.origin, spacing=vol.spacing,
             box=([ext[0, 0], ext[1, 0], z_lo], [ext[0, 1], ext[1, 1], z_hi]), view=view,
-            filt=filt, transfer=Glow(1.0), ds=0.41 * vol.spacing.min(),
+            filt=filt, transfer=transfer, ds=0.41 * vol.spacing.min(),
             value_range=reconstructed_range(vol, filt), early_termination=1.0,
             exact_ends=ends == "exact")
         parts.append(rgba)
