@@ -136,7 +136,7 @@ def _check(view):
     """Refuse what three- and two-pass shearing cannot render."""
     if view.is_perspective:
         raise ValueError("three- and two-pass shearing factor an affine view: orthographic "
-                         "only; use method='shearwarp' or 'raycast' for perspective")
+                         "only; use method='shearwarp' or method='raycast' for perspective")
 
 
 def _filled(first, last, length):
