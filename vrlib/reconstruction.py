@@ -39,7 +39,9 @@ def reconstruct(volume, points, *, filter="trilinear", derivative=False):
         the volume).
     derivative : bool, default False
         Return the gradient ``(dF/dx, dF/dy, dF/dz)`` in world units instead of the value
-        (the filter's derivative kernel along one axis, its kernel along the others).
+        (the filter's derivative kernel along one axis, its kernel along the others). The box
+        filter's derivative is zero, so it gives the samples' gradient at the sample it takes
+        (central differences, :func:`numpy.gradient`): what every renderer shades by.
 
     Returns
     -------
