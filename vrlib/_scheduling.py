@@ -1,18 +1,16 @@
 """How parallel loops share out their work: each thread of a numba ``prange`` takes one
-contiguous run of the iteration space, so the order of the items decides the balance (and
-:func:`run_in_threads` hands serial kernels one run each in the same way); and how many
-threads they run on."""
+contiguous run of the iteration space, so the order of the items decides the balance; and how
+many threads they run on."""
 
 from __future__ import annotations
 
 import contextlib
 import numbers
-from concurrent.futures import ThreadPoolExecutor
 
 import numba
 import numpy as np
 
-__all__ = ["balanced_order", "balanced_runs", "run_in_threads", "thread_count"]
+__all__ = ["balanced_order", "thread_count"]
 
 
 @contextlib.contextmanager
@@ -40,44 +38,21 @@ def thread_count(threads):
         numba.set_num_threads(previous)
 
 
-def balanced_runs(costs, parts):
-    """Items dealt to ``parts`` runs of nearly equal work: sorted by estimated cost and dealt
-    in snake order (heaviest first, 0, 1, ..., p-1, p-1, ..., 0), so each run holds items
-    from all over the image.
-
-    Examples
-    --------
-    >>> [run.tolist() for run in balanced_runs(np.array([5.0, 1.0, 1.0, 5.0]), 2)]
-    [[0, 2], [3, 1]]
-    """
-    order = np.argsort(-np.asarray(costs, dtype=np.float64), kind="stable")
-    runs = [[] for _ in range(parts)]
-    for rank, tile in enumerate(order):
-        cycle, position = divmod(rank, parts)
-        runs[position if cycle % 2 == 0 else parts - 1 - position].append(tile)
-    return [np.asarray(run, dtype=np.int64) for run in runs]
-
-
 def balanced_order(costs, parts):
-    """Tile order for a parallel loop that hands each of ``parts`` threads an equal run of it:
-    the runs of :func:`balanced_runs`, one after the other.
+    """Tile order for a parallel loop that hands each of ``parts`` threads an equal run of it.
+
+    Tiles are sorted by estimated cost and dealt to ``parts`` runs in snake order (heaviest
+    first, 0, 1, ..., p-1, p-1, ..., 0), so the runs carry nearly equal work and each holds
+    tiles from all over the image.
 
     Examples
     --------
     >>> balanced_order(np.array([5.0, 1.0, 1.0, 5.0]), 2).tolist()
     [0, 2, 3, 1]
     """
-    return np.concatenate(balanced_runs(costs, parts))
-
-
-def run_in_threads(work, runs):
-    """Call ``work(run)`` for each of ``runs``, each on a thread of its own, and wait for all
-    (``work`` calls a serial kernel that releases the GIL, numba's ``nogil``). The threads
-    share nothing they write, so the result does not depend on their number or timing.
-    """
-    if len(runs) == 1:
-        work(runs[0])
-        return
-    with ThreadPoolExecutor(max_workers=len(runs)) as pool:
-        for done in [pool.submit(work, run) for run in runs]:
-            done.result()
+    order = np.argsort(-np.asarray(costs, dtype=np.float64), kind="stable")
+    runs = [[] for _ in range(parts)]
+    for rank, tile in enumerate(order):
+        cycle, position = divmod(rank, parts)
+        runs[position if cycle % 2 == 0 else parts - 1 - position].append(tile)
+    return np.concatenate([np.asarray(run, dtype=np.int64) for run in runs])

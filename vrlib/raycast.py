@@ -19,7 +19,7 @@ from vrlib import validate
 from vrlib._kernels import raycast as _kernel
 from vrlib._kernels._jit import readonly
 from vrlib._kernels.filters import TENT
-from vrlib._scheduling import balanced_runs, run_in_threads
+from vrlib._scheduling import balanced_order
 from vrlib.adaptive import step_multipliers
 from vrlib.image import Image, RenderStats
 from vrlib.prefilter import Tally, prepared
@@ -281,27 +281,23 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
               *lattice_extent(global_shape, spacing, origin).T.copy())
     skips = (early_termination, *skip, np.zeros((1, 1, 1)) if bound is None else bound,
              float(budget))
-    runs = balanced_runs(costs, numba.get_num_threads())
+    tiles = (*TILE, balanced_order(costs, numba.get_num_threads()), out, samples)
     if preintegrated:
         profile = "step" if filt.radius <= 0.5 else "linear"  # the box filter jumps
-        table = transfer.preintegrated_table(ds, *value_range, profile=profile)
         _kernel.raycast_preintegrated(
             *layout, view.packed(), view.height, view.width, ds, *filt.code, filt.radius,
-            filt.taps, *table, *lighting, *by_gradient, *skips, *TILE, np.concatenate(runs),
-            out, samples)
+            filt.taps, *transfer.preintegrated_table(ds, *value_range, profile=profile),
+            *lighting, *by_gradient, *skips, *tiles)
     else:
         grey = shading is None and bool(np.all(tables[4] == 1.0))  # colour equals opacity
-        multiplier = np.ones((1, 1, 1), np.int64) if multiplier is None else multiplier
-        arguments = (*layout, bool(exact_ends), view.packed(), view.height, view.width, ds,
-                     *filt.code, filt.radius, filt.taps, *tables, *lighting, *by_gradient,
-                     *skips, multiplier, *TILE)
-        if filt.code[0] == TENT and shading is None and ramp is None:
-            # A kernel of its own, compiled in half the time (a first render's wait), its
-            # runs of tiles on Python threads.
-            skipping = None if skip[2] == 0 else True
-            run_in_threads(lambda run: _kernel.raycast(*arguments, run, out, samples, grey,
-                                                       None, skipping), runs)
-        else:
-            _kernel.raycast_parallel(*arguments, np.concatenate(runs), out, samples, grey)
+        # The kernel compiled for this kind of render (the tent filter unshaded, a volume
+        # with nothing to skip: a smaller kernel, a shorter first wait).
+        general = None if filt.code[0] == TENT and shading is None and ramp is None else True
+        skipping = None if skip[2] == 0 else True
+        _kernel.raycast(
+            *layout, bool(exact_ends), view.packed(), view.height, view.width, ds,
+            *filt.code, filt.radius, filt.taps, *tables, *lighting, *by_gradient, *skips,
+            np.ones((1, 1, 1), np.int64) if multiplier is None else multiplier, *tiles, grey,
+            general, skipping)
     np.clip(out[..., 3], 0.0, 1.0, out=out[..., 3])
     return out, int(samples.sum())

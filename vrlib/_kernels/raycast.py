@@ -456,7 +456,7 @@ def _tile_preintegrated(tile_id, data, flat, inv, fine_counts, coarse_counts, of
     return taken
 
 
-@jit
+@parallel_jit
 def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_hi, exact,
             camera, height, width, ds,
             fkind, fp0, fp1, fp2, radius, ntaps,
@@ -464,12 +464,7 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
             shade, ka, kd, ks, shininess, light, headlight, ramp_x, ramp_y, by_gradient,
             threshold, empty, coarse, block, mask, bound, budget, multiplier, tile_h, tile_w,
             order, out, samples, grey, general, skipping):
-    """Render the tiles ``order`` of ``out[row, col] = (r, g, b, a)`` premultiplied; count
-    samples per tile. ``vrlib.raycast`` calls it once per thread for the tent filter's
-    unshaded renders, each thread with its own run of tiles
-    (:func:`vrlib._scheduling.run_in_threads`), ``general`` None: compiling a numba
-    ``prange`` took two of the first render's seconds. Other renders take
-    :func:`raycast_parallel`.
+    """Render ``out[row, col] = (r, g, b, a)`` premultiplied; count samples per tile.
 
     ``data`` holds the samples from global index ``offset`` on (the whole volume, or a brick
     with ghost samples) of a volume of global shape ``gshape`` whose sample 0 is at world
@@ -494,39 +489,15 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
     ``grey`` says the emission is 1 everywhere and unshaded, so colour equals opacity.
     ``by_gradient`` multiplies the density by the piecewise-linear factor through
     ``(ramp_x, ramp_y)`` of the gradient magnitude (per world unit).
-    ``general`` None compiles only the tent filter and a table's colour, no shading and no
-    gradient opacity (numba prunes the other branches for a None argument: a first render of
-    that kind compiles half as much); any other value compiles every path. ``skipping``
-    None likewise leaves out the skipping (``block = 0``).
+
+    Compiled per kind of render: ``general`` None compiles only the tent filter and a
+    table's colour, without shading or gradient opacity, and ``skipping`` None leaves out
+    the skipping (``block = 0``). numba drops a branch on a None argument before it types
+    the function, so such a kernel compiles in about half the time (a first render's wait);
+    ``True`` compiles every path.
     """
-    flat = data.reshape(-1)
-    inv = 1.0 / spacing
-    fine_counts = np.array(empty.shape)
-    coarse_counts = np.array(coarse.shape)
-    for it in range(order.shape[0]):
-        tile_id = order[it]
-        samples[tile_id] = _tile(
-            tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, origin,
-            box_lo, box_hi, vol_lo, vol_hi, exact, camera, height, width,
-            ds, fkind, fp0, fp1, fp2, radius, ntaps, tstart, tinv, alpha_tab, color_tab,
-            emit_tab, shade, ka, kd, ks, shininess, light, headlight, ramp_x, ramp_y,
-            by_gradient, threshold, empty, coarse, block, mask, bound, budget, multiplier,
-            tile_h, tile_w, out, grey, general, skipping)
-
-
-
-@parallel_jit
-def raycast_parallel(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_hi,
-                     exact, camera, height, width, ds, fkind, fp0, fp1, fp2, radius, ntaps,
-                     tstart, tinv, alpha_tab, color_tab, emit_tab, shade, ka, kd, ks,
-                     shininess, light, headlight, ramp_x, ramp_y, by_gradient, threshold,
-                     empty, coarse, block, mask, bound, budget, multiplier, tile_h, tile_w,
-                     order, out, samples, grey):
-    """:func:`raycast` with ``general`` set, over all the tiles ``order`` on numba's threads
-    (``prange``, each thread one contiguous run): the kernel for every render but the tent
-    filter's unshaded ones. Its compile takes seconds more than :func:`raycast`'s, but the
-    tile function it calls runs a third faster with shading (2.6 s against 3.4 s measured,
-    256^3 -> 512^2, one thread) when numba compiles it inside the parallel loop."""
+    # The loop runs one compiled tile function per task: numba's parallel passes then see this
+    # short loop only, not the tracing code (a third of the compile time otherwise).
     flat = data.reshape(-1)
     inv = 1.0 / spacing
     fine_counts = np.array(empty.shape)
@@ -539,7 +510,8 @@ def raycast_parallel(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_
             ds, fkind, fp0, fp1, fp2, radius, ntaps, tstart, tinv, alpha_tab, color_tab,
             emit_tab, shade, ka, kd, ks, shininess, light, headlight, ramp_x, ramp_y,
             by_gradient, threshold, empty, coarse, block, mask, bound, budget, multiplier,
-            tile_h, tile_w, out, grey, True, True)
+            tile_h, tile_w, out, grey, general, skipping)
+
 
 @jit
 def _tile(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, origin,
