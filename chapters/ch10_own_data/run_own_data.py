@@ -107,7 +107,11 @@ def transfer_kinds(mni, frog):
     by_gradient = vrlib.colormap("bone", [(0, 0), (0.3, 0), (0.6, 0.6), (1, 0.9)], volume=mni,
                                  shading=shaded, gradient_opacity=vrlib.GradientOpacity(
                                      [0.0, *edges], [0.0, 0.0, 1.0]))
-    fire = vrlib.colormap("inferno", [(0, 1), (1, 1)], clim=(0.4, mni.value_range[1]),
+    # The maximum along nearly every ray through the head lies in white matter: the rays'
+    # maxima lie between 0.78 and 0.92 (25th and 95th percentiles, measured on this
+    # template; its top value is 0.99), so a window from 0.4 up drew a flat silhouette.
+    top = mni.value_range[1]
+    fire = vrlib.colormap("inferno", [(0, 1), (1, 1)], clim=(0.75 * top, 0.94 * top),
                           volume=mni)
     cut = np.array(mni.data, dtype=np.float64)
     half_y, half_x = cut.shape[1] // 2, cut.shape[2] // 2
