@@ -501,10 +501,8 @@ def cmd_bench(args):
 
 def _type_name(dtype):
     """A sample type as a user reads it: its name and, for multi-byte types, byte order."""
-    order = {">": ", big-endian", "<": ", little-endian"}.get(dtype.byteorder, "")
-    if dtype.byteorder == "=":
-        order = f", {sys.byteorder}-endian" if dtype.itemsize > 1 else ""
-    return f"{dtype.name}{order if dtype.itemsize > 1 else ''}"
+    order = {">": "big", "<": "little", "=": sys.byteorder}.get(dtype.byteorder)
+    return dtype.name if order is None or dtype.itemsize == 1 else f"{dtype.name}, {order}-endian"
 
 
 def describe_volume(volume):
