@@ -27,8 +27,8 @@ from vrlib.skipping import BLOCK, block_densities, coarsen, footprint_mask, visi
 from vrlib.value_bounds import reconstructed_range
 from vrlib.volume import lattice_extent
 
-__all__ = ["render_raycast", "cast_rays", "operations_per_sample", "skip_bounds",
-           "brightest"]
+__all__ = ["render_raycast", "cast_rays", "segment_options", "operations_per_sample",
+           "skip_bounds", "brightest"]
 
 #: Pixels (rows, columns) of the image tiles that the parallel loop hands out.
 TILE = (32, 32)
@@ -96,19 +96,8 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
     """
     skip_budget = validate.finite_number("skip_budget", skip_budget, low=0.0)
     step_budget = validate.finite_number("step_budget", step_budget, low=0.0)
-    validate.choice("classification", classification, CLASSIFICATIONS)
-    preint = classification == "preintegrated"
-    if segment_ends is None:
-        segment_ends = "exact" if preint else "lattice"
-    validate.choice("segment_ends", segment_ends, SEGMENT_ENDS)
-    if preint and segment_ends != "exact":
-        raise ValueError("classification='preintegrated' takes its segments' values at their "
-                         "ends, which must lie inside the volume: use segment_ends='exact' "
-                         "(or leave it out)")
-    if preint and volume.holes is not None:
-        raise ValueError("classification='preintegrated' cannot take holes "
-                         "(nan='transparent'): no value runs linearly into a hole; use "
-                         "classification='point'")
+    exact, preint = segment_options(segment_ends, classification,
+                                    holes=volume.holes is not None)
     if step_budget > 0.0:
         if preint:
             raise ValueError("step_budget > 0 (adaptive steps) is built for "
@@ -154,7 +143,7 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
         volume.data, offset=(0, 0, 0), global_shape=volume.shape, origin=volume.origin,
         spacing=volume.spacing, box=(box_lo, box_hi), view=view, filt=filt, transfer=transfer,
         ds=ds, value_range=value_range,
-        early_termination=early_termination, skip=skip, exact_ends=segment_ends == "exact",
+        early_termination=early_termination, skip=skip, exact_ends=exact,
         preintegrated=preint, bound=bound, budget=skip_budget, multiplier=multiplier,
     )
     stats = RenderStats(
@@ -164,6 +153,33 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
         seconds=time.perf_counter() - start,
     )
     return Image(rgba, tally.finish(stats, filt))
+
+
+def segment_options(segment_ends, classification, *, holes=False):
+    """Check how segments end and are classified (:func:`render_raycast`'s arguments, also
+    taken by the MPI renderers); returns ``(exact_ends, preintegrated)``.
+
+    Examples
+    --------
+    >>> segment_options(None, "preintegrated")
+    (True, True)
+    >>> segment_options(None, "point")
+    (False, False)
+    """
+    validate.choice("classification", classification, CLASSIFICATIONS)
+    preint = classification == "preintegrated"
+    if segment_ends is None:
+        segment_ends = "exact" if preint else "lattice"
+    validate.choice("segment_ends", segment_ends, SEGMENT_ENDS)
+    if preint and segment_ends != "exact":
+        raise ValueError("classification='preintegrated' takes its segments' values at their "
+                         "ends, which must lie inside the volume: use segment_ends='exact' "
+                         "(or leave it out)")
+    if preint and holes:
+        raise ValueError("classification='preintegrated' cannot take holes "
+                         "(nan='transparent'): no value runs linearly into a hole; use "
+                         "classification='point'")
+    return segment_ends == "exact", preint
 
 
 def skip_bounds(densities, volume, transfer, ds, value_range):

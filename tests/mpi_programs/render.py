@@ -7,7 +7,8 @@ each, unless a view names its own ``filter``) and ``cases`` (``[compositing, bal
 or ``["image", null]``, ``["image-interleaved", null]`` for 8-pixel tiles dealt round-robin;
 ``radix-k:2x3`` is radix-k with factors 2, 3); the transfer function
 is ``Glow(glow)``, or with ``threshold`` a ramp that is transparent below it; ``shade`` adds
-Phong shading and ``gradient_opacity`` (``[magnitudes, factors]``) a gradient ramp.
+Phong shading and ``gradient_opacity`` (``[magnitudes, factors]``) a gradient ramp;
+``step``, ``segment_ends`` and ``classification`` are passed to every render.
 Rank 0 prints one JSON line: per case, the largest difference from the serial render, the
 bytes each rank sent per phase, the rectangles it sent while compositing, the samples and the
 peak resident memory per rank.
@@ -39,6 +40,8 @@ def main(comm, config):
     source, shape = field, config.get("n")
     if "file" in config:
         source, shape = config["file"], None
+    options = {key: config[key] for key in ("step", "segment_ends", "classification")
+               if key in config}
     results = []
     for orbit in config["views"]:
         orbit = dict(orbit)
@@ -49,18 +52,20 @@ def main(comm, config):
             if comm.Get_rank() == 0:
                 volume = field.sample(shape) if shape else data_gen.load(source)
                 serial = vrlib.render(volume, view, filter=filt,
-                                      transfer=transfer, early_termination=1.0).rgba
+                                      transfer=transfer, early_termination=1.0,
+                                      **options).rgba
             for compositing, balance in config["cases"]:
                 if compositing.startswith("image"):
                     layout = "interleaved" if compositing == "image-interleaved" else \
                         "contiguous"
                     frame = mpi.render_image(comm, source, view, shape=shape, filter=filt,
-                                             transfer=transfer, layout=layout, tile=8)
+                                             transfer=transfer, layout=layout, tile=8,
+                                             **options)
                 else:
                     frame = mpi.render_object(comm, source, view, shape=shape,
                                               filter=filt, transfer=transfer,
                                               compositing=compositing,
-                                              balance=balance)
+                                              balance=balance, **options)
                 if comm.Get_rank() == 0:
                     results.append({
                         "view": orbit, "filter": filt, "compositing": compositing,

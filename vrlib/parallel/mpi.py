@@ -39,7 +39,7 @@ from vrlib.parallel.decompose import interleaved_owners, screen_tiles, split
 from vrlib.parallel.exchange import Exchange
 from vrlib.parallel.sources import RawFile, ghost, global_value_range, open_source
 from vrlib.parallel.stage import RankFailed, Stage
-from vrlib.raycast import cast_rays
+from vrlib.raycast import cast_rays, segment_options
 from vrlib.skipping import BLOCK, brick_empty_blocks, coarsen, footprint_mask
 
 __all__ = ["render_object", "render_image", "RankFailed", "Frame", "visible_cells",
@@ -80,9 +80,15 @@ class Frame:
 
 
 def _cast(data, first, brick_lo, brick_hi, lattice, view, filt, transfer, ds, value_range,
-          pixels=None):
-    """Ray-cast one brick's samples; ``pixels`` restricts the rays to a mask."""
-    empty = brick_empty_blocks(data, first, brick_lo, brick_hi, lattice.cells, filt, transfer)
+          pixels=None, exact_ends=False, preintegrated=False, reach=0):
+    """Ray-cast one brick's samples; ``pixels`` restricts the rays to a mask.
+
+    A pre-integrated segment whose middle lies in the brick reads values up to half a step
+    beyond it: ``reach`` cells each side, which the brick's ghost samples hold, count in its
+    empty blocks too, so that it skips exactly what the serial render skips."""
+    near = [max(0, a - reach) for a in brick_lo], [min(n, b + reach) for b, n in
+                                                  zip(brick_hi, lattice.cells, strict=True)]
+    empty = brick_empty_blocks(data, first, *near, lattice.cells, filt, transfer)
     mask = footprint_mask(view, lattice, empty, BLOCK) if not empty.all() else \
         np.zeros(view.shape, dtype=bool)
     if pixels is not None:
@@ -93,7 +99,8 @@ def _cast(data, first, brick_lo, brick_hi, lattice, view, filt, transfer, ds, va
     return cast_rays(data, offset=tuple(first), global_shape=lattice.shape,
                      origin=lattice.origin, spacing=lattice.spacing, box=box, view=view,
                      filt=filt, transfer=transfer, ds=ds, value_range=value_range,
-                     early_termination=1.0, skip=(empty, coarsen(empty), BLOCK, mask))
+                     early_termination=1.0, skip=(empty, coarsen(empty), BLOCK, mask),
+                     exact_ends=exact_ends, preintegrated=preintegrated)
 
 
 def _peak_rss():
@@ -140,7 +147,7 @@ def _check(view, filter, transfer, step, compositing=None, balance=None,
 
 def render_object(comm, source, view, *, shape=None, extent=None, filter="trilinear",
                   transfer=None, step=0.5, compositing="binary-swap", balance="even",
-                  bricks_per_rank=4, root=0):
+                  bricks_per_rank=4, segment_ends=None, classification="point", root=0):
     """Render ``source`` with an object partition over the ranks of ``comm``.
 
     Parameters
@@ -168,6 +175,11 @@ def render_object(comm, source, view, *, shape=None, extent=None, filter="trilin
         How bricks are cut and dealt (see the module's notes).
     bricks_per_rank : int
         Bricks per rank for ``"interleaved"``.
+    segment_ends, classification
+        As :func:`vrlib.render`'s ray-casting options: the volume's outer faces cut the
+        segments (``"exact"``), never a brick's; a pre-integrated segment belongs to the brick
+        that holds its middle, which reads half a step past its box from ghost samples. The
+        image equals the serial render's with the same options.
     root : int
         Rank that receives the image.
 
@@ -202,6 +214,7 @@ def render_object(comm, source, view, *, shape=None, extent=None, filter="trilin
     with Stage(comm, "checking the arguments"):
         filt, transfer, step, compositor = _check(view, filter, transfer, step, compositing,
                                                   balance, bricks_per_rank)
+        exact, preint = segment_options(segment_ends, classification)
         root = _root(root, size)
         lattice, read = open_source(source, shape, extent)
         _refuse_default_transfer(source, transfer_given)
@@ -212,11 +225,13 @@ def render_object(comm, source, view, *, shape=None, extent=None, filter="trilin
             tree = compositor.split(lattice.cells, size)
         owners = interleaved_owners(len(tree), size)
     ds = step * float(lattice.spacing.min())
+    # A pre-integrated segment's ends reach half a step past its brick's box.
+    reach = math.ceil(0.5 * step) if preint else 0
     with Stage(comm, "reading its bricks"):
         mine = [b for b in tree.bricks if owners[b.index] == rank]
         bricks = []
         for brick in mine:
-            region = brick.samples(ghost(filt), lattice.shape)
+            region = brick.samples(ghost(filt) + reach, lattice.shape)
             bricks.append((brick, [a for a, _ in region], read(region)))
     value_range = global_value_range(comm, [float(d.min()) for *_, d in bricks],
                                      [float(d.max()) for *_, d in bricks], filt)
@@ -226,14 +241,15 @@ def render_object(comm, source, view, *, shape=None, extent=None, filter="trilin
         tree = work_split(block_work, lattice.cells, size, splitter=compositor.split)
         with Stage(comm, "reading its re-balanced brick"):
             brick = tree.bricks[rank]
-            region = brick.samples(ghost(filt), lattice.shape)
+            region = brick.samples(ghost(filt) + reach, lattice.shape)
             bricks = [(brick, [a for a, _ in region], read(region))]
     with Stage(comm, "rendering"):
         start = time.perf_counter()
         held, samples = [], 0  # (brick, its full-screen local image)
         for brick, first, data in bricks:
             rgba, taken = _cast(data, first, brick.lo, brick.hi, lattice, view, filt,
-                                transfer, ds, value_range)
+                                transfer, ds, value_range, exact_ends=exact,
+                                preintegrated=preint, reach=reach)
             held.append((brick, rgba))
             samples += taken
         render_s = time.perf_counter() - start
@@ -287,7 +303,8 @@ def _needed(view, lattice, region, tiles, reach):
 
 
 def render_image(comm, source, view, *, shape=None, extent=None, filter="trilinear",
-                 transfer=None, step=0.5, layout="contiguous", tile=16, root=0):
+                 transfer=None, step=0.5, layout="contiguous", tile=16, segment_ends=None,
+                 classification="point", root=0):
     """Render ``source`` with an image partition over the ranks of ``comm``.
 
     The volume stays where it is loaded, one brick per rank (no ghosts); each rank owns
@@ -315,6 +332,7 @@ def render_image(comm, source, view, *, shape=None, extent=None, filter="triline
     transfer_given = transfer is not None
     with Stage(comm, "checking the arguments"):
         filt, transfer, step, _ = _check(view, filter, transfer, step)
+        exact, preint = segment_options(segment_ends, classification)
         validate.choice("layout", layout, ("contiguous", "interleaved"))
         root = _root(root, size)
         lattice, read = open_source(source, shape, extent)
@@ -376,7 +394,8 @@ def render_image(comm, source, view, *, shape=None, extent=None, filter="triline
                 local, offset=tuple(lo), global_shape=lattice.shape, origin=lattice.origin,
                 spacing=lattice.spacing, box=lattice.box((0, 0, 0), lattice.cells), view=view,
                 filt=filt, transfer=transfer, ds=ds, value_range=value_range,
-                early_termination=1.0, skip=(skip_grid, coarsen(skip_grid), BLOCK, mask))
+                early_termination=1.0, skip=(skip_grid, coarsen(skip_grid), BLOCK, mask),
+                exact_ends=exact, preintegrated=preint)
         render_s = time.perf_counter() - start
     rgba = gather_to_root(comm, [(r, rects.pixels(rgba, r)) for r in mine], view.shape, root,
                           sent)
