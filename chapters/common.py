@@ -17,6 +17,7 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
+import matplotlib.text  # noqa: E402
 
 from vrlib.atomic import atomic_path  # noqa: E402
 
@@ -47,10 +48,79 @@ def figure_path(script, name):
     return ROOT / "figures" / _chapter(script) / name
 
 
+#: Resolution figures are saved at.
+DPI = 150
+#: PNG text key under which a figure's text layout (:func:`text_layout`) is stored, for
+#: ``make report-check`` to judge at the width the page shows it.
+LAYOUT_KEY = "vrlib-text-layout"
+
+
 def save_figure(fig, path):
-    """Save a matplotlib figure atomically (format from the suffix)."""
+    """Save a matplotlib figure atomically (format from the suffix); a PNG carries its text
+    layout (:func:`text_layout`) in its metadata."""
+    metadata = {"Software": None}
+    if Path(path).suffix == ".png":
+        metadata[LAYOUT_KEY] = json.dumps(text_layout(fig))
     with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=150, bbox_inches="tight", metadata={"Software": None})
+        fig.savefig(tmp, dpi=DPI, bbox_inches="tight", metadata=metadata)
+
+
+def text_layout(fig):
+    """What a reader needs of a figure's text: the saved image's width in pixels, its
+    smallest text (font size in the image's pixels, and the text), and every pair of texts,
+    or text and another panel, that overlap (one hides part of the other).
+
+    Examples
+    --------
+    >>> import matplotlib.pyplot as plt
+    >>> fig, (a, b) = plt.subplots(2, 1, figsize=(3, 2))
+    >>> _ = a.set_xlabel("a long label that runs into the panel below", fontsize=14)
+    >>> layout = text_layout(fig)
+    >>> layout["smallest"][0] < 14 * DPI / 72, layout["overlaps"][0].startswith("'a long")
+    (True, True)
+    >>> plt.close(fig)
+    """
+    renderer = fig.canvas.get_renderer()
+    fig.draw(renderer)
+    texts = []
+    for text in fig.findobj(matplotlib.text.Text):
+        label = text.get_text().strip()
+        if not label or not text.get_visible() or text.get_alpha() == 0:
+            continue
+        box = text.get_window_extent(renderer)
+        if box.width <= 0 or box.height <= 0:
+            continue
+        texts.append((label, text.get_fontsize() * DPI / 72.0, box, text.axes))
+    overlaps = []
+    for i, (label, _, box, axes) in enumerate(texts):
+        for other, _, other_box, _ in texts[i + 1:]:
+            if _overlap(box, other_box) > 0.15:
+                overlaps.append(f"{label[:30]!r} over {other[:30]!r}")
+        for panel in fig.axes:
+            if panel is axes or not _shows_something(panel):
+                continue
+            if _overlap(box, panel.get_window_extent(renderer)) > 0.15:
+                overlaps.append(f"{label[:30]!r} over the panel {panel.get_title()[:30]!r}")
+    tight = fig.get_tightbbox(renderer)
+    smallest = min(((size, label) for label, size, _, _ in texts), default=(None, ""))
+    return {"width": round((tight.width + 0.2) * DPI), "smallest": [smallest[0],
+                                                                   smallest[1][:40]],
+            "overlaps": overlaps}
+
+
+def _shows_something(panel):
+    """Whether a panel draws anything a text over it would hide (an empty frame does not)."""
+    return panel.get_visible() and bool(panel.axison or panel.images or panel.lines
+                                        or panel.collections or panel.patches)
+
+
+def _overlap(box, other):
+    """Share of ``box``'s area that ``other`` covers."""
+    width = min(box.x1, other.x1) - max(box.x0, other.x0)
+    height = min(box.y1, other.y1) - max(box.y0, other.y0)
+    if width <= 0 or height <= 0:
+        return 0.0
+    return width * height / (box.width * box.height)
 
 
 def write_json(path, data):

@@ -10,7 +10,11 @@ A page fails when:
 - raw TeX shows in its rendered text (``\\(``, ``$$``, ``\\frac`` ... outside code), or MathJax
   reports an error in a formula;
 - an image is shown at less than half its own width without a link to the full-size file;
-- a table is wider than the text column it sits in.
+- a table is wider than the text column it sits in;
+- a figure's text, at the width the page shows the figure, is smaller than
+  :data:`MIN_TEXT_PX` pixels, or a text overlaps another text or another panel (a title cut
+  by the image above it, a cell's text spilling into the next): the chapter scripts store
+  each figure's text layout in its PNG (``chapters.common.text_layout``).
 
 The layout checks run inside the page: a copy of it with a small probe script is opened and
 the probe's findings read back from the rendered DOM (``--dump-dom``). Prints one line per page
@@ -27,8 +31,12 @@ from pathlib import Path
 
 import imageio.v3 as iio
 import numpy as np
+import PIL.Image
 
 SKIP = {"genindex.html", "search.html", "py-modindex.html"}
+#: Smallest font size (CSS pixels) a figure's text may have as the page shows it.
+MIN_TEXT_PX = 9.0
+LAYOUT_KEY = "vrlib-text-layout"  # chapters.common.LAYOUT_KEY (the report needs no chapters)
 WINDOW = (1280, 2000)
 OFFLINE = ["--proxy-server=http://127.0.0.1:9", "--proxy-bypass-list=<-loopback>"]
 # Long enough for MathJax to typeset the longest page (virtual time: it passes as fast as the
@@ -43,8 +51,8 @@ window.addEventListener("load", async () => {
   if (window.MathJax && MathJax.startup && MathJax.startup.promise) {
     try { await MathJax.startup.promise; } catch (e) {}
   }
-  const out = {tex: [], mathErrors: 0, images: [], tables: [], mathjax: !!(window.MathJax &&
-               MathJax.version)};
+  const out = {tex: [], mathErrors: 0, images: [], tables: [], shown: [],
+               mathjax: !!(window.MathJax && MathJax.version)};
   const commands = "frac|mathrm|mathbf|sum|int|sqrt|sigma|alpha|omega|le|ge|cdot|times|text";
   const raw = new RegExp(String.raw`\\\(|\\\)|\\\[|\\\]|\$\$|\\(${commands})\b|` +
                          String.raw`\$[^$\s][^$]*[^$\s\\]\$`);
@@ -61,6 +69,7 @@ window.addEventListener("load", async () => {
                  document.body;
   for (const img of column.querySelectorAll("img")) {
     const shown = img.getBoundingClientRect().width;
+    out.shown.push([img.getAttribute("src"), shown]);
     if (img.naturalWidth > 0 && shown < img.naturalWidth / 2 && !img.closest("a[href]")) {
       const size = `${Math.round(shown)} of ${img.naturalWidth} px`;
       out.images.push(`${img.getAttribute("src")} (${size})`);
@@ -153,6 +162,28 @@ def check_images(page, sources):
     return problems
 
 
+def check_text(page, shown):
+    """Problems of the figures' text as the page shows them (``shown``: ``[src, width]``)."""
+    problems = []
+    for src, width in shown:
+        target = (page.parent / src.split("#")[0]).resolve()
+        if target.suffix != ".png" or not target.is_file() or width <= 0:
+            continue
+        with PIL.Image.open(target) as picture:
+            layout = picture.text.get(LAYOUT_KEY)
+            natural = picture.width
+        if layout is None:
+            continue
+        layout = json.loads(layout)
+        size, text = layout["smallest"]
+        if size is not None and size * width / natural < MIN_TEXT_PX:
+            problems.append(f"{target.name}: text {text!r} is {size * width / natural:.1f} px "
+                            f"high as shown (at least {MIN_TEXT_PX:g})")
+        if layout["overlaps"]:
+            problems.append(f"{target.name}: overlapping text: {layout['overlaps'][:2]}")
+    return problems
+
+
 def check_page(chrome, page, name, shots):
     resources = Resources()
     resources.feed(page.read_text(encoding="utf-8"))
@@ -170,6 +201,7 @@ def check_page(chrome, page, name, shots):
             problems.append(f"image shown at under half its width with no link: {found['images']}")
         if found["tables"]:
             problems.append(f"table wider than the text column: {found['tables']}")
+        problems += check_text(page, found["shown"])
     out = shots / (name.replace("/", "-").removesuffix(".html") + ".png")
     out.unlink(missing_ok=True)
     chrome_run(chrome, f"--screenshot={out}", page.as_uri())

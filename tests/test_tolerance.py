@@ -87,3 +87,24 @@ def test_an_unreachable_tolerance_is_refused_with_what_is_reachable():
     vol = data_gen.make_field("marschner-lobb").sample(13)
     with pytest.raises(ValueError, match=r"out of reach .* at least"):
         render(vol, View.orbit(size=16), transfer=steep(vol), tolerance=1e-7)
+
+
+def test_a_memo_shared_between_renders_changes_no_image():
+    """The pilot's renders share the blocks' densities and footprint (``memo``); each image
+    equals the one rendered without it, for several steps and two views in turn."""
+    from vrlib.filters import make_filter
+    from vrlib.raycast import render_raycast
+
+    vol = data_gen.make_field("random-blobs", count=4, seed=2, sigma=(0.06, 0.1)).sample(33)
+    views = [View.orbit(azimuth=a, elevation=20, size=24).fitted(vol.extent) for a in (30, 70)]
+    ramp = LookupTransfer(np.clip(np.linspace(-4.0, 16.0, 101), 0.0, None))  # empty blocks
+    options = dict(filt=make_filter("trilinear"), transfer=ramp, early_termination=1.0,
+                   empty_space_skipping=True, segment_ends="exact")
+    memo = {}
+    for view in views:
+        for step in (2.0, 1.0, 0.5):
+            shared = render_raycast(vol, view, step=step, memo=memo, **options)
+            alone = render_raycast(vol, view, step=step, **options)
+            assert np.array_equal(shared.rgba, alone.rgba)
+            assert shared.alpha.max() > 0.2
+    assert memo["view"] is views[-1] and memo["skip"][0].any()

@@ -64,7 +64,7 @@ CLASSIFICATIONS = ("point", "preintegrated")
 
 def render_raycast(volume, view, *, filt, transfer, step, early_termination,
                    empty_space_skipping, segment_ends=None, classification="point",
-                   skip_budget=0.0, step_budget=0.0):
+                   skip_budget=0.0, step_budget=0.0, memo=None):
     """Ray-cast ``volume`` (arguments already validated by :func:`vrlib.render`).
 
     ``segment_ends="lattice"`` lets every sample stand for a whole step, also where the
@@ -93,6 +93,11 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
     blocks where the classified field changes slowly enough that no pixel moves by more than
     the budget from the image at ``step`` (adaptive steps, :mod:`vrlib.adaptive`); 0 takes
     every step. Point classification without shading or gradient opacity only.
+
+    ``memo`` (a dict, empty at first) keeps what depends only on the volume, filter and
+    transfer function (the blocks' densities) and on the view (the pixels whose rays can
+    meet a block) between renders of one scene at several steps: a render to a tolerance's
+    pilot images. The images are the same with it or without.
     """
     skip_budget = validate.finite_number("skip_budget", skip_budget, low=0.0)
     step_budget = validate.finite_number("step_budget", step_budget, low=0.0)
@@ -119,8 +124,11 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
     skip = bound = multiplier = None
     if skip_budget > 0.0 and not empty_space_skipping:
         raise ValueError("skip_budget > 0 skips blocks: it needs empty_space_skipping=True")
+    memo = {} if memo is None else memo
     if empty_space_skipping:
-        densities = block_densities(volume, filt, transfer, block=BLOCK)
+        if "densities" not in memo:
+            memo["densities"] = block_densities(volume, filt, transfer, block=BLOCK)
+        densities = memo["densities"]
         empty = densities <= 0.0
         if skip_budget > 0.0:
             bound = skip_bounds(densities, volume, transfer, ds, value_range)
@@ -138,7 +146,11 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
             if preint:  # a segment owned outside the box reaches half a step into it
                 box_lo = np.maximum(box_lo - 0.5 * ds, extent[:, 0])
                 box_hi = np.minimum(box_hi + 0.5 * ds, extent[:, 1])
-            skip = (empty, coarsen(empty), BLOCK, footprint_mask(view, volume, empty, BLOCK))
+            if memo.get("view") is not view:
+                memo["view"] = view
+                memo["skip"] = (empty, coarsen(empty), BLOCK,
+                                footprint_mask(view, volume, empty, BLOCK))
+            skip = memo["skip"]
     rgba, taken = cast_rays(
         volume.data, offset=(0, 0, 0), global_shape=volume.shape, origin=volume.origin,
         spacing=volume.spacing, box=(box_lo, box_hi), view=view, filt=filt, transfer=transfer,

@@ -17,7 +17,9 @@ How it is kept (docs/kernel.md):
 * The step takes :data:`STEP_SHARE` of ``t``. A pilot renders the view at a quarter of its
   pixels per axis with steps of 2, 1, 1/2 ... voxels. The differences between successive
   pilot images give the order of convergence ``p`` (taken between 1 and 2) and the error of
-  the finest, ``d / (2^p - 1)`` (Richardson). The step is then the one whose extrapolated
+  the finest, ``d / (2^p - 1)`` (Richardson). When the first two already differ by at most
+  half the share, the coarsest step is taken at once: its error is at most ``2 d`` for any
+  order of at least 1. The step is then the one whose extrapolated
   error is the share, but never coarser than the pilot's coarsest. The pilot goes on halving
   while the step it predicts lies below half its finest step, so the prediction never
   reaches far past what it measured.
@@ -93,7 +95,7 @@ def render_within(volume, view, *, filt, transfer, tolerance, empty_space_skippi
     early_termination = 1.0 - TERM_SHARE * tolerance / light
     options = dict(filt=filt, transfer=transfer, early_termination=early_termination,
                    empty_space_skipping=empty_space_skipping, segment_ends="exact",
-                   classification=classification)
+                   classification=classification, memo={})  # the pilots' shared skip grids
 
     pilot_view = view.resized(tuple(max(PILOT_MIN, n // PILOT_SHRINK) for n in view.shape))
     if pilot_view.height >= view.height and pilot_view.width >= view.width:
@@ -108,6 +110,11 @@ def render_within(volume, view, *, filt, transfer, tolerance, empty_space_skippi
         if previous is not None:
             differences.append(rmse(previous, pilot))
         previous = pilot
+        if len(differences) == 1 and 2.0 * differences[0] <= target:
+            # The coarsest step already meets the share: with order >= 1 its error is at
+            # most d / (1 - 2^-p) <= 2 d, coherent or not (a third pilot would only cost).
+            predicted, error_at = MAX_STEP, _first_order_bound(differences[0])
+            break
         if len(differences) >= 2:
             predicted, error_at = _predict(steps, differences, target)
             if predicted >= 0.5 * steps[-1] or step / 2.0 < MIN_STEP:
@@ -133,6 +140,12 @@ def render_within(volume, view, *, filt, transfer, tolerance, empty_space_skippi
                   "differences": differences, "seconds": pilot_seconds},
     }
     return image
+
+
+def _first_order_bound(difference):
+    """The error model after two pilots whose images differ by ``difference``: at most twice
+    that at the coarser step (order at least 1)."""
+    return lambda h: 2.0 * difference * h / MAX_STEP
 
 
 def _predict(steps, differences, target):
