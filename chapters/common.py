@@ -55,14 +55,57 @@ DPI = 150
 LAYOUT_KEY = "vrlib-text-layout"
 
 
+#: Width (CSS pixels) of the report's text column, where a full-width figure is shown, and
+#: the smallest font size (CSS pixels) a figure's text may have there.
+PAGE_WIDTH_PX = 736
+MIN_FONT_PX = 9.0
+
+
 def save_figure(fig, path):
-    """Save a matplotlib figure atomically (format from the suffix); a PNG carries its text
-    layout (:func:`text_layout`) in its metadata."""
+    """Save a matplotlib figure atomically (format from the suffix), with no text smaller than
+    :data:`MIN_FONT_PX` at the report's column width (:func:`readable`); a PNG carries its
+    text layout (:func:`text_layout`) in its metadata."""
+    readable(fig)
     metadata = {"Software": None}
     if Path(path).suffix == ".png":
         metadata[LAYOUT_KEY] = json.dumps(text_layout(fig))
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=DPI, bbox_inches="tight", metadata=metadata)
+
+
+def readable(fig, margin=1.1):
+    """Raise every text that a full-width figure would show below :data:`MIN_FONT_PX` (with
+    ``margin``) to that size. The figure's layout engine (``layout="tight"`` or
+    ``"constrained"``) then makes room for it when the figure is saved.
+
+    Examples
+    --------
+    >>> import matplotlib.pyplot as plt
+    >>> fig, ax = plt.subplots(figsize=(10, 3), layout="tight")
+    >>> _ = ax.set_title("small", fontsize=5)
+    >>> readable(fig)
+    >>> ax.title.get_fontsize() > 5                # at least 9.9 px in a 736 px column
+    True
+    >>> plt.close(fig)
+    """
+    renderer = fig.canvas.get_renderer()
+    for _ in range(3):  # larger text widens the saved figure: again until none is too small
+        fig.draw(renderer)  # lays the figure out and makes its tick labels
+        width = fig.get_tightbbox(renderer).width + 0.2  # inches, as saved (with padding)
+        smallest = margin * MIN_FONT_PX * 72.0 * width / PAGE_WIDTH_PX  # points
+        small = [text for text in fig.findobj(matplotlib.text.Text)
+                 if text.get_text().strip() and text.get_fontsize() < smallest]
+        if not small:
+            return
+        for text in small:
+            text.set_fontsize(smallest)
+        for axes in fig.axes:  # tick labels made at the next draw take the axes' size
+            for axis in (axes.xaxis, axes.yaxis):
+                for which in ("major", "minor"):
+                    ticks = axis.get_major_ticks() if which == "major" else \
+                        axis.get_minor_ticks()
+                    if ticks and ticks[0].label1.get_fontsize() < smallest:
+                        axis.set_tick_params(which=which, labelsize=smallest)
 
 
 def text_layout(fig):
@@ -76,25 +119,39 @@ def text_layout(fig):
     >>> fig, (a, b) = plt.subplots(2, 1, figsize=(3, 2))
     >>> _ = a.set_xlabel("a long label that runs into the panel below", fontsize=14)
     >>> layout = text_layout(fig)
-    >>> layout["smallest"][0] < 14 * DPI / 72, layout["overlaps"][0].startswith("'a long")
-    (True, True)
+    >>> layout["smallest"][0] < 14 * DPI / 72
+    True
+    >>> [o for o in layout["overlaps"] if o.startswith("'a long")]
+    ["'a long label that runs into th' over the panel ''"]
     >>> plt.close(fig)
     """
     renderer = fig.canvas.get_renderer()
-    fig.draw(renderer)
+    drawn = []  # the texts drawn: an axis keeps tick labels it does not draw
+    draw = matplotlib.text.Text.draw
+
+    def recorded(text, renderer):
+        draw(text, renderer)
+        drawn.append(text)
+
+    matplotlib.text.Text.draw = recorded
+    try:
+        fig.draw(renderer)
+    finally:
+        matplotlib.text.Text.draw = draw
     texts = []
-    for text in fig.findobj(matplotlib.text.Text):
+    for text in drawn:
         label = text.get_text().strip()
         if not label or not text.get_visible() or text.get_alpha() == 0:
             continue
         box = text.get_window_extent(renderer)
         if box.width <= 0 or box.height <= 0:
             continue
-        texts.append((label, text.get_fontsize() * DPI / 72.0, box, text.axes))
+        upright = text.get_rotation() % 90.0 == 0.0  # else its box is far larger than it
+        texts.append((label, text.get_fontsize() * DPI / 72.0, box, text.axes, upright))
     overlaps = []
-    for i, (label, _, box, axes) in enumerate(texts):
-        for other, _, other_box, _ in texts[i + 1:]:
-            if _overlap(box, other_box) > 0.15:
+    for i, (label, _, box, axes, upright) in enumerate(texts):
+        for other, _, other_box, _, other_upright in texts[i + 1:]:
+            if upright and other_upright and _overlap(box, other_box) > 0.15:
                 overlaps.append(f"{label[:30]!r} over {other[:30]!r}")
         for panel in fig.axes:
             if panel is axes or not _shows_something(panel):
@@ -102,7 +159,7 @@ def text_layout(fig):
             if _overlap(box, panel.get_window_extent(renderer)) > 0.15:
                 overlaps.append(f"{label[:30]!r} over the panel {panel.get_title()[:30]!r}")
     tight = fig.get_tightbbox(renderer)
-    smallest = min(((size, label) for label, size, _, _ in texts), default=(None, ""))
+    smallest = min(((size, label) for label, size, *_ in texts), default=(None, ""))
     return {"width": round((tight.width + 0.2) * DPI), "smallest": [smallest[0],
                                                                    smallest[1][:40]],
             "overlaps": overlaps}

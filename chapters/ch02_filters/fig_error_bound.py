@@ -10,7 +10,7 @@ from chapters.common import figure_path, read_json, result_path, save_figure
 def main():
     data = read_json(result_path(__file__, "error_bound.json"))
     ratios = np.array(data["ratios"])
-    fig, axes = plt.subplots(1, 2, figsize=(9, 4), sharey=True)
+    fig, axes = plt.subplots(1, 2, figsize=(9, 4), sharey=True, layout="tight")
     for ax, dims in zip(axes, ("1d", "3d"), strict=True):
         for index, (label, s) in enumerate(data["sweep"].items()):
             colour = f"C{index}"
@@ -29,7 +29,6 @@ def main():
     axes[0].set_ylabel(r"$E(\sigma/h) = \max |R - f| / f(0)$")
     axes[0].legend(fontsize=8)
     fig.suptitle("Measured worst case (solid) and Fourier bound (dashed)", fontsize=10)
-    fig.tight_layout()
     save_figure(fig, figure_path(__file__, "error_bound.png"))
 
 

@@ -9,7 +9,7 @@ from chapters.common import figure_path, result_path, save_figure
 def main():
     data = np.load(result_path(__file__, "responses.npz"))
     omega, labels, curves = data["omega"], data["labels"], data["curves"]
-    fig, (lin, log) = plt.subplots(1, 2, figsize=(9, 3.8))
+    fig, (lin, log) = plt.subplots(1, 2, figsize=(9, 3.8), layout="tight")
     for label, k in zip(labels, curves, strict=True):
         style = "--" if str(label).startswith("gaussian") else "-"
         lin.plot(omega / np.pi, k, style, label=str(label), lw=1.4)
@@ -26,7 +26,6 @@ def main():
     log.set_ylim(1e-6, 2)
     log.set_title("Magnitude (log): leakage past Nyquist")
     lin.legend(fontsize=8, ncol=2)
-    fig.tight_layout()
     save_figure(fig, figure_path(__file__, "frequency_response.png"))
 
 

@@ -13,7 +13,7 @@ MARKERS = dict(zip(vrlib.filters.STANDARD, "sov*PD^<>hX", strict=False))
 
 
 def model_fit():
-    fig, ax = plt.subplots(figsize=(5.5, 5))
+    fig, ax = plt.subplots(figsize=(5.5, 5), layout="tight")
     for index, record in enumerate(_merged.machines(__file__)):
         rows, _ = _merged.fitted(record)
         for backend in sorted({r["backend"] for r in rows}):
@@ -27,7 +27,6 @@ def model_fit():
     ax.set_ylabel("model: c_op ops + c_pt points + c_0 (s)")
     ax.legend(fontsize=7)
     ax.set_title("Cost model fitted per machine and backend")
-    fig.tight_layout()
     save_figure(fig, figure_path(__file__, "model_fit.png"))
     plt.close(fig)
 
@@ -35,7 +34,8 @@ def model_fit():
 def regimes():
     data = read_json(result_path(__file__, "regimes.json"))
     scenes, ms, methods = data["scenes"], data["pixels_per_voxel"], data["methods"]
-    fig, axes = plt.subplots(1, 2, figsize=(9, 3.4))
+    # One panel above the other: each cell's three lines need a quarter of the page's width.
+    fig, axes = plt.subplots(2, 1, figsize=(8, 7.5), layout="tight")
     for ax, key, title in [(axes[0], "ns_per_point", "ns per reconstructed point"),
                            (axes[1], "seconds", "frame time (ms)")]:
         cheapest = np.zeros((len(scenes), len(ms)), int)
@@ -47,7 +47,7 @@ def regimes():
                 cheapest[i, j] = methods.index(best)
                 text = "\n".join(f"{k}: {v * (1e3 if key == 'seconds' else 1):.3g}"
                                  for k, v in here.items())
-                ax.text(j, i, text, ha="center", va="center", fontsize=6.5)
+                ax.text(j, i, text, ha="center", va="center")
         colours = [COLOURS[m] for m in methods]
         from matplotlib.colors import ListedColormap
 
@@ -58,15 +58,15 @@ def regimes():
         ax.set_yticks(range(len(scenes)), [f"{s} ({frac[s]:.0%} visible)" for s in scenes])
         ax.set_title(f"Cheapest by {title} (cell colour)")
     handles = [plt.Rectangle((0, 0), 1, 1, color=COLOURS[m], alpha=0.35) for m in methods]
-    fig.legend(handles, methods, loc="lower center", ncol=len(methods), fontsize=8)
-    fig.tight_layout(rect=(0, 0.08, 1, 1))
+    fig.legend(handles, methods, loc="lower center", ncol=len(methods))
+    fig.get_layout_engine().set(rect=(0, 0.05, 1, 1))
     save_figure(fig, figure_path(__file__, "regimes.png"))
     plt.close(fig)
 
 
 def pareto():
     data = read_json(result_path(__file__, "pareto.json"))
-    fig, ax = plt.subplots(figsize=(10, 5.5))
+    fig, ax = plt.subplots(figsize=(10, 5.5), layout="tight")
     for r in data["rows"]:
         size = {None: 40, 1.0: 25, 0.5: 45, 0.25: 70}[r["step"]]
         if r["method"] in COLOURS:
@@ -98,7 +98,6 @@ def pareto():
     ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.01, 0.5))
     ax.set_title(f"Marschner-Lobb {data['n']}^3 into {data['size']}^2: time against error "
                  "(marker size: step)")
-    fig.tight_layout()
     save_figure(fig, figure_path(__file__, "pareto.png"))
     plt.close(fig)
 

@@ -10,7 +10,7 @@ from chapters.common import figure_path, read_json, result_path, save_figure
 def main():
     data = read_json(result_path(__file__, "saving.json"))
     out, per_n3 = ratios(data)
-    fig, (left, right) = plt.subplots(1, 2, figsize=(9, 3.8))
+    fig, (left, right) = plt.subplots(1, 2, figsize=(9, 3.8), layout="tight")
     names = list(out)
     left.boxplot([out[n] for n in names], tick_labels=names, widths=0.5)
     for x, (lo, hi) in enumerate((PREDICTED[n] for n in names), start=1):
@@ -28,7 +28,6 @@ def main():
     right.set_ylabel("samples resampled / N$^3$")
     right.set_title("Work per frame against the view", fontsize=10)
     right.legend()
-    fig.tight_layout()
     save_figure(fig, figure_path(__file__, "saving.png"))
 
 

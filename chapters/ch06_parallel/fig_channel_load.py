@@ -22,7 +22,7 @@ def series(rows, name, torus, key):
 def main():
     data = read_json(result_path(__file__, "network.json"))
     rows = data["rows"]
-    fig, axes = plt.subplots(2, 2, figsize=(10, 8))
+    fig, axes = plt.subplots(2, 2, figsize=(10, 8), layout="tight")
     panels = [(axes[0, 0], False, "max", "busiest channel, mesh"),
               (axes[0, 1], False, "mean", "mean channel, mesh"),
               (axes[1, 0], True, "max", "busiest channel, torus")]
@@ -54,7 +54,6 @@ def main():
                  "rectangles (dotted)", fontsize=9)
     ax.legend(fontsize=7.5)
     ax.grid(True, which="both", alpha=0.3)
-    fig.tight_layout()
     save_figure(fig, figure_path(__file__, "channel_load.png"))
 
 

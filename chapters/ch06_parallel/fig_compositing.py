@@ -26,7 +26,7 @@ def default(sel):
 def main():
     data = read_json(result_path(__file__, "compositing.json"))
     rows, nodes = data["rows"], data["nodes"]
-    fig, axes = plt.subplots(1, 3, figsize=(11, 3.9))
+    fig, axes = plt.subplots(1, 3, figsize=(11, 3.9), layout="tight")
     for ax, kind in zip(axes[:2], ("torus", "mesh"), strict=True):
         best = {b["nodes"]: b for b in data["best"][kind]}
         for label, pick, style in (
@@ -60,7 +60,6 @@ def main():
     for ax in axes:
         ax.xaxis.set_minor_formatter(NullFormatter())
         ax.yaxis.set_minor_formatter(NullFormatter())
-    fig.tight_layout()
     save_figure(fig, figure_path(__file__, "compositing.png"))
     table = []
     for torus, mesh in zip(data["best"]["torus"], data["best"]["mesh"], strict=True):

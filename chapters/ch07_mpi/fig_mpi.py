@@ -15,7 +15,7 @@ COLOURS = {"direct-send": "C3", "binary-swap": "C0", "radix-k": "C1", "image": "
 def main():
     data = read_json(result_path(__file__, "mpi.json"))
     ortho = data["settings"]["orbit"]
-    fig, axes = plt.subplots(3, 2, figsize=(10, 11.5))
+    fig, axes = plt.subplots(3, 2, figsize=(10, 11.5), layout="tight")
     panels = axes.ravel()
     ax = panels[0]
     for key in (*OBJECT, "image", "image-interleaved"):
@@ -99,7 +99,6 @@ def main():
         ax.grid(True, which="both", alpha=0.3)
         ax.xaxis.set_minor_formatter(NullFormatter())
         ax.yaxis.set_minor_formatter(NullFormatter())
-    fig.tight_layout()
     save_figure(fig, figure_path(__file__, "mpi.png"))
 
 

@@ -10,7 +10,7 @@ from chapters.common import figure_path, read_json, result_path, save_figure
 def precision_figure():
     data = read_json(result_path(__file__, "precision.json"))
     opacity = read_json(result_path(__file__, "opacity.json"))
-    fig, axes = plt.subplots(1, 3, figsize=(12, 4.2))
+    fig, axes = plt.subplots(1, 3, figsize=(12, 4.2), layout="tight")
     ax = axes[0]
     rows = data["accumulation"]
     for mean, ls in zip(sorted({r["mean_alpha"] for r in rows}), ("-", "--", ":"), strict=True):
@@ -48,13 +48,12 @@ def precision_figure():
     ax.legend(fontsize=8)
     for a in axes:
         a.grid(True, which="both", alpha=0.3)
-    fig.tight_layout()
     save_figure(fig, figure_path(__file__, "precision.png"))
 
 
 def convergence_figure():
     data = read_json(result_path(__file__, "convergence.json"))
-    fig, (left, right) = plt.subplots(1, 2, figsize=(9, 3.8))
+    fig, (left, right) = plt.subplots(1, 2, figsize=(9, 3.8), layout="tight")
     for filt, entry in data["steps"].items():
         rows = entry["rows"]
         left.loglog([r["step"] for r in rows], [r["max_error"] for r in rows], "-o", ms=4,
@@ -74,14 +73,13 @@ def convergence_figure():
     right.legend(fontsize=8)
     for a in (left, right):
         a.grid(True, which="both", alpha=0.3)
-    fig.tight_layout()
     save_figure(fig, figure_path(__file__, "convergence.png"))
 
 
 def segment_ends_figure():
     data = read_json(result_path(__file__, "segment_ends.json"))
     scenes = list(dict.fromkeys(r["scene"] for r in data["rows"]))
-    fig, axes = plt.subplots(1, len(scenes), figsize=(11, 3.6), sharey=True)
+    fig, axes = plt.subplots(1, len(scenes), figsize=(11, 3.6), sharey=True, layout="tight")
     styles = {("trilinear", "lattice"): "--o", ("trilinear", "exact"): "-o",
               ("catmull-rom", "lattice"): "--s", ("catmull-rom", "exact"): "-s"}
     for ax, scene in zip(axes, scenes, strict=True):
@@ -93,7 +91,6 @@ def segment_ends_figure():
         ax.grid(True, which="both", alpha=0.3)
         ax.legend(fontsize=7)
     axes[0].set_ylabel("rmse against the reconstructed field's exact image")
-    fig.tight_layout()
     save_figure(fig, figure_path(__file__, "segment_ends.png"))
 
 

@@ -22,16 +22,15 @@ def main():
               for row in info["transfer_functions"]]
     if info["brainsmall"]["available"]:  # with Debian's libvolpack1-dev installed
         panels.append((images["brainsmall"], "VolPack's brainsmall.den,\nauto, bone, shaded"))
-    fig, axes = plt.subplots(3, 3, figsize=(7.2, 7.6))
+    fig, axes = plt.subplots(3, 3, figsize=(7.2, 7.6), layout="tight")
     for ax in axes.ravel()[len(panels):]:
         ax.axis("off")
     for ax, (rgba, title) in zip(axes.ravel(), panels, strict=False):
         _show(ax, rgba, title)
-    fig.tight_layout()
     save_figure(fig, figure_path(__file__, "transfer_functions.png"))
 
     methods = list(vrlib.METHODS)
-    fig, axes = plt.subplots(2, len(methods) + 1, figsize=(8.4, 3.2))
+    fig, axes = plt.subplots(2, len(methods) + 1, figsize=(8.4, 3.2), layout="tight")
     _show(axes[0, 0], images["aniso/reference"], "ray cast, step 1/8")
     axes[1, 0].axis("off")
     reference = images["aniso/reference"]
@@ -45,7 +44,6 @@ def main():
         axes[1, m].set_title(f"opacity difference\n+-{bound:.1e}", fontsize=7)
         axes[1, m].set_xticks([])
         axes[1, m].set_yticks([])
-    fig.tight_layout()
     save_figure(fig, figure_path(__file__, "anisotropic.png"))
 
 

@@ -15,7 +15,7 @@ def promise_figure():
     cases = [c for c in data["cases"] if "rmse" in c]
     scenes = list(dict.fromkeys(c["scene"] for c in cases))
     labels = {c["scene"]: c["label"] for c in cases}
-    fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.4))
+    fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.4), layout="tight")
     for i, scene in enumerate(scenes):
         for view, fill in (("orthographic", True), ("perspective", False)):
             sel = [c for c in cases if c["scene"] == scene and c["view"] == view]
@@ -43,14 +43,13 @@ def promise_figure():
     right.set_title("Time, pilot included, against a grid search", fontsize=10)
     for ax in (left, right):
         ax.grid(True, which="both", alpha=0.3)
-    fig.tight_layout()
     save_figure(fig, figure_path(__file__, "promise.png"))
 
 
 def preintegration_figure():
     data = read_json(result_path(__file__, "preintegration.json"))
     rows = data["rows"]
-    fig, axes = plt.subplots(2, 3, figsize=(11, 7), sharey=False)
+    fig, axes = plt.subplots(2, 3, figsize=(11, 7), sharey=False, layout="tight")
     axes = axes.ravel()
     styles = {"point, lattice ends": "--o", "point, exact ends": ":s",
               "pre-integrated": "-D"}
@@ -65,17 +64,22 @@ def preintegration_figure():
     ax = axes[len(rows)]
     for i, row in enumerate(rows):
         ratios = [np.nan if r is None else r for r in row["sample_ratio"]]
-        ax.semilogx(data["steps"], ratios, "-" + MARKERS[i], ms=4, label=row["scene"])
+        ax.semilogx(data["steps"], ratios, "-" + MARKERS[i], ms=4, label=_short(row["scene"]))
     ax.axhline(4.0, color="k", lw=1, ls="--")
     ax.set_xlabel("step of point sampling (voxels)")
     ax.set_ylabel("samples saved at its error")
     ax.set_title("Point samples / pre-integrated samples", fontsize=9)
-    ax.legend(fontsize=6)
+    ax.legend(loc="upper right")
     ax.grid(True, which="both", alpha=0.3)
     for extra in axes[len(rows) + 1:]:
         extra.set_visible(False)
-    fig.tight_layout()
     save_figure(fig, figure_path(__file__, "preintegration.png"))
+
+
+def _short(scene):
+    """'Marschner-Lobb 41^3, peak 3% wide' -> 'Marschner-Lobb, 3%' (the panels name it)."""
+    field, peak = scene.split(", ")
+    return f"{field.rsplit(' ', 1)[0]}, {peak.split()[1]}"
 
 
 def main():
