@@ -88,24 +88,40 @@ def readable(fig, margin=1.1):
     True
     >>> plt.close(fig)
     """
-    renderer = fig.canvas.get_renderer()
     for _ in range(3):  # larger text widens the saved figure: again until none is too small
-        fig.draw(renderer)  # lays the figure out and makes its tick labels
+        renderer, drawn = _draw(fig)
         width = fig.get_tightbbox(renderer).width + 0.2  # inches, as saved (with padding)
         smallest = margin * MIN_FONT_PX * 72.0 * width / PAGE_WIDTH_PX  # points
-        small = [text for text in fig.findobj(matplotlib.text.Text)
-                 if text.get_text().strip() and text.get_fontsize() < smallest]
+        small = [text for text in drawn if text.get_fontsize() < smallest]
         if not small:
             return
         for text in small:
             text.set_fontsize(smallest)
-        for axes in fig.axes:  # tick labels made at the next draw take the axes' size
+        for axes in fig.axes:  # tick labels made at the next draw take the axis's size
             for axis in (axes.xaxis, axes.yaxis):
-                for which in ("major", "minor"):
-                    ticks = axis.get_major_ticks() if which == "major" else \
-                        axis.get_minor_ticks()
-                    if ticks and ticks[0].label1.get_fontsize() < smallest:
-                        axis.set_tick_params(which=which, labelsize=smallest)
+                ticks = axis.get_major_ticks()
+                if ticks and ticks[0].label1.get_fontsize() < smallest:
+                    axis.set_tick_params(which="both", labelsize=smallest)
+
+
+def _draw(fig):
+    """Draw ``fig``; returns the renderer and the texts it drew that show something (an axis
+    keeps tick labels it does not draw, which :meth:`Figure.findobj` would also find)."""
+    renderer = fig.canvas.get_renderer()
+    drawn = []
+    draw = matplotlib.text.Text.draw
+
+    def recorded(text, renderer):
+        draw(text, renderer)
+        drawn.append(text)
+
+    matplotlib.text.Text.draw = recorded
+    try:
+        fig.draw(renderer)
+    finally:
+        matplotlib.text.Text.draw = draw
+    return renderer, [text for text in drawn if text.get_text().strip()
+                      and text.get_visible() and text.get_alpha() != 0]
 
 
 def text_layout(fig):
@@ -125,24 +141,10 @@ def text_layout(fig):
     ["'a long label that runs into th' over the panel ''"]
     >>> plt.close(fig)
     """
-    renderer = fig.canvas.get_renderer()
-    drawn = []  # the texts drawn: an axis keeps tick labels it does not draw
-    draw = matplotlib.text.Text.draw
-
-    def recorded(text, renderer):
-        draw(text, renderer)
-        drawn.append(text)
-
-    matplotlib.text.Text.draw = recorded
-    try:
-        fig.draw(renderer)
-    finally:
-        matplotlib.text.Text.draw = draw
+    renderer, drawn = _draw(fig)
     texts = []
     for text in drawn:
         label = text.get_text().strip()
-        if not label or not text.get_visible() or text.get_alpha() == 0:
-            continue
         box = text.get_window_extent(renderer)
         if box.width <= 0 or box.height <= 0:
             continue
