@@ -11,7 +11,7 @@ import vrlib
 from vrlib import Glow, LookupTransfer, Phong, View, render
 from vrlib.adaptive import block_differences, gradient_bounds, step_multipliers
 from vrlib.raycast import brightest, cast_rays
-from vrlib.skipping import coarsen
+from vrlib.skipping import clearance
 from vrlib.value_bounds import reconstructed_range
 
 TABLE = LookupTransfer([0.0, 3.0, 0.5, 4.0], color=[[1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 1]])
@@ -39,7 +39,7 @@ def _cast(vol, view, filt, transfer, step, multiplier, *, ends="lattice", data=N
         box=(ext[:, 0], ext[:, 1]) if box is None else box, view=view, filt=filt,
         transfer=transfer, ds=step * vol.spacing.min(),
         value_range=reconstructed_range(vol, filt), early_termination=1.0,
-        skip=(empty, coarsen(empty), 8, np.ones(view.shape, dtype=bool)),
+        skip=(empty, clearance(empty), 8, np.ones(view.shape, dtype=bool)),
         exact_ends=ends == "exact", multiplier=multiplier)
     return rgba, taken
 

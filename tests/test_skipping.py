@@ -5,7 +5,7 @@ import pytest
 from naive import reconstruct_naive
 
 from vrlib import Glow, LookupTransfer, Volume, make_filter
-from vrlib.skipping import empty_blocks
+from vrlib.skipping import clearance, empty_blocks
 from vrlib.value_bounds import lattice_sums
 
 
@@ -61,3 +61,23 @@ def test_vectorised_max_density_matches_scalar():
     np.testing.assert_array_equal(many, one)
     for a, b, m in zip(lo[:50], hi[:50], many[:50], strict=True):
         assert m == pytest.approx(tf.opacity_density(np.linspace(a, b, 20001)).max(), abs=1e-3)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_clearance_is_the_distance_to_the_other_kind(seed):
+    """A ray jumps (or samples unchecked) across the cube of 2|d| - 1 blocks around a block of
+    clearance d: every block of that cube must be of the block's kind, and one at distance |d|
+    must not be (else the jump would be shorter than it could be). Brute force on random
+    grids, sparse to dense, and the grids of one kind only."""
+    rng = np.random.default_rng(seed)
+    empty = rng.random((5, 7, 6)) < (0.3, 0.7, 0.95, 0.99)[seed]
+    reach = clearance(empty)
+    index = np.indices(empty.shape).reshape(3, -1).T
+    for here in index:
+        distance = np.abs(index - here).max(axis=1)
+        other = empty.reshape(-1) != empty[tuple(here)]
+        d = reach[tuple(here)]
+        assert (d > 0) == empty[tuple(here)]
+        assert distance[other].min() == abs(d)
+    assert (clearance(np.ones((2, 3, 4), bool)) == 4).all()
+    assert (clearance(np.zeros((2, 3, 4), bool)) == -4).all()

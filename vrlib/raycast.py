@@ -23,7 +23,7 @@ from vrlib._scheduling import balanced_order
 from vrlib.adaptive import step_multipliers
 from vrlib.image import Image, RenderStats
 from vrlib.prefilter import Tally, prepared
-from vrlib.skipping import BLOCK, block_densities, coarsen, footprint_mask, visible_box
+from vrlib.skipping import BLOCK, block_densities, clearance, footprint_mask, visible_box
 from vrlib.value_bounds import reconstructed_range
 from vrlib.volume import lattice_extent
 
@@ -148,7 +148,7 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
                 box_hi = np.minimum(box_hi + 0.5 * ds, extent[:, 1])
             if memo.get("view") is not view:
                 memo["view"] = view
-                memo["skip"] = (empty, coarsen(empty), BLOCK,
+                memo["skip"] = (empty, clearance(empty), BLOCK,
                                 footprint_mask(view, volume, empty, BLOCK))
             skip = memo["skip"]
     rgba, taken = cast_rays(
@@ -286,7 +286,7 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
         lighting = (True, shading.ambient, shading.diffuse, shading.specular,
                     shading.shininess, light, shading.light is None)
     if skip is None:
-        skip = (np.zeros((1, 1, 1), dtype=bool), np.zeros((1, 1, 1), dtype=bool), 0,
+        skip = (np.zeros((1, 1, 1), dtype=bool), np.zeros((1, 1, 1), np.int64), 0,
                 np.ones(view.shape, dtype=bool))
     ramp = transfer.gradient_opacity
     by_gradient = (np.zeros(2), np.zeros(2), False) if ramp is None else (

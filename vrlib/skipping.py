@@ -7,9 +7,10 @@ reconstructed value by :func:`vrlib.value_bounds.value_bounds`. The test is cons
 skipping never changes an image.
 
 Ray casters skip with the block grid and the geometry built from it here (the box around what
-is visible, the pixels whose rays can meet it, a coarser grid for long jumps); slice-by-slice
-renderers (shear-warp) skip along rows instead: :func:`transparent_runs` gives, for each row of
-each slice, the first and last sample above a transparency bound.
+is visible, the pixels whose rays can meet it, each empty block's distance to the nearest block
+that is not, for long jumps); slice-by-slice renderers (shear-warp) skip along rows instead:
+:func:`transparent_runs` gives, for each row of each slice, the first and last sample above a
+transparency bound.
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ import numpy as np
 
 from vrlib.value_bounds import value_bounds
 
-__all__ = ["BLOCK", "block_densities", "empty_blocks", "brick_empty_blocks", "coarsen",
+__all__ = ["BLOCK", "block_densities", "empty_blocks", "brick_empty_blocks", "clearance",
            "visible_box", "footprint_mask", "transparent_runs"]
 
 #: Cells per block (each axis) of the empty-space skipping grid.
@@ -101,20 +102,26 @@ def brick_empty_blocks(data, first, lo, hi, cells, filt, transfer, *, block=BLOC
     return empty
 
 
-def coarsen(empty, factor=4):
-    """Blocks of ``factor^3`` blocks that are all empty (edge blocks padded as empty).
+def clearance(empty):
+    """Per block, the Chebyshev distance (in blocks) to the nearest block of the other kind:
+    positive for an empty block, negative for one that is not. Every block within ``|d| - 1``
+    blocks of a block at distance ``d`` is of its kind, so a ray can cross the whole cube of
+    ``2 |d| - 1`` blocks a side around it at once, jumping (empty) or sampling without a
+    check (not empty). Where every block is of one kind, the grid's largest extent.
 
     Examples
     --------
-    >>> coarsen(np.ones((5, 4, 4), dtype=bool)).shape
-    (2, 1, 1)
+    >>> empty = np.ones((1, 1, 7), dtype=bool); empty[0, 0, 1:3] = False
+    >>> clearance(empty)
+    array([[[ 1, -1, -1,  1,  2,  3,  4]]])
     """
-    pad = [(0, -n % factor) for n in empty.shape]
-    padded = np.pad(empty, pad, constant_values=True)
-    shape = []
-    for n in padded.shape:
-        shape += [n // factor, factor]
-    return padded.reshape(shape).all(axis=(1, 3, 5))
+    from scipy.ndimage import distance_transform_cdt
+
+    reach = np.full(empty.shape, max(empty.shape), dtype=np.int64)
+    if empty.all() or not empty.any():
+        return reach if empty.all() else -reach
+    return (distance_transform_cdt(empty, metric="chessboard")
+            - distance_transform_cdt(~empty, metric="chessboard")).astype(np.int64)
 
 
 def visible_box(volume, empty, block, lo, hi):

@@ -66,15 +66,17 @@ def _block_bound(bound, cells, ux, uy, uz):
 
 
 @jit
-def _exit(ax, ay, az, bx, by, bz, cells, counts, ux, uy, uz):
-    """Ray parameter where the ray (index position ``a + t b``) leaves the block that holds
-    ``(ux, uy, uz)`` on a grid of ``cells``-cell blocks (``counts`` blocks per axis, z y x)."""
+def _exit(ax, ay, az, bx, by, bz, cells, counts, ux, uy, uz, reach=1):
+    """Ray parameter where the ray (index position ``a + t b``) leaves the cube of
+    ``2 reach - 1`` blocks a side centred on the block that holds ``(ux, uy, uz)``, on a grid
+    of ``cells``-cell blocks (``counts`` blocks per axis, z y x): that block itself for
+    ``reach = 1``."""
     t_exit = math.inf
     for a, b, u, n in ((ax, bx, ux, counts[2]), (ay, by, uy, counts[1]),
                        (az, bz, uz, counts[0])):
         if b != 0.0:
             block = _cell(u, cells, n)
-            edge = (block + 1) * cells if b > 0.0 else block * cells
+            edge = (block + reach) * cells if b > 0.0 else (block + 1 - reach) * cells
             t_exit = min(t_exit, (edge - a) / b)
     return t_exit
 
@@ -142,21 +144,30 @@ def _other_value(data, flat, nx, nxy, oz, oy, ox, gz, gy, gx, offset, gshape, ux
 
 
 @jit(inline="always")
-def _skip(k, ux, uy, uz, ax, ay, az, bx, by, bz, ds, by_front, empty, coarse, block,
-          fine_counts, coarse_counts, bound, budget, spent, k_first, k_last, t_first, t_last):
+def _skip(k, ux, uy, uz, ax, ay, az, bx, by, bz, ds, by_front, empty, clearance, block,
+          fine_counts, bound, budget, spent, k_first, k_last, t_first, t_last, blockwise):
     """Skipping at segment ``k``, whose check point (its sample, or its front end when
     ``by_front``: a pre-integrated segment) lies at index position ``u``: returns
     ``(k_next, t_check, spent)``. ``k_next > k`` skips to segment ``k_next``; otherwise
     the segment is taken, and so are those before ``t_check`` (their block is not empty).
 
-    An empty block is jumped over (the largest empty block here: the coarse one if it is
-    empty), then any segment that rounding placed in a block that is not empty is stepped
-    back over: the image is unchanged. By its front end, only the segments that also end
-    inside the empty block are jumped, so that the whole run lies in one empty box. A block
-    that is not empty is left out while the bounds of what the ray has left out stay within
-    ``budget`` (``spent`` so far)."""
-    if not _is_empty(empty, block, ux, uy, uz):
-        t_exit = _exit(ax, ay, az, bx, by, bz, block, fine_counts, ux, uy, uz)
+    From an empty block the ray jumps out of the cube of empty blocks around it (its
+    ``clearance``: :func:`vrlib.skipping.clearance`), then any segment that rounding placed
+    in a block that is not empty is stepped back over: the image is unchanged. By its front
+    end, only the segments that also end inside an empty block are jumped, so that the whole
+    run lies in one empty box. In a block that is not empty, ``t_check`` is where the ray
+    leaves the cube of such blocks around it (taking a sample that lies in an empty block
+    adds exactly nothing), or the block itself with a ``budget`` or when ``blockwise``
+    (adaptive steps: a step per block). With a budget, a block that is not empty is left out
+    while the bounds of what the ray has left out stay within ``budget`` (``spent`` so
+    far)."""
+    reach = _block_bound(clearance, block, ux, uy, uz)
+    if reach <= 0:  # a block that is not empty
+        if budget > 0.0 or blockwise:
+            t_exit = _exit(ax, ay, az, bx, by, bz, block, fine_counts, ux, uy, uz)
+        else:
+            # Every block within the clearance is not empty: sample on to the cube's face.
+            t_exit = _exit(ax, ay, az, bx, by, bz, block, fine_counts, ux, uy, uz, -reach)
         if budget > 0.0:
             cost = _block_bound(bound, block, ux, uy, uz)
             if spent + cost <= budget:
@@ -165,10 +176,8 @@ def _skip(k, ux, uy, uz, ax, ay, az, bx, by, bz, ds, by_front, empty, coarse, bl
                     return max(math.ceil(t_exit / ds), k + 1), -math.inf, spent + cost
                 return max(math.ceil(t_exit / ds - 0.5), k + 1), -math.inf, spent + cost
         return k, t_exit, spent
-    if _is_empty(coarse, 4 * block, ux, uy, uz):
-        t_exit = _exit(ax, ay, az, bx, by, bz, 4 * block, coarse_counts, ux, uy, uz)
-    else:
-        t_exit = _exit(ax, ay, az, bx, by, bz, block, fine_counts, ux, uy, uz)
+    # Every block within the clearance is empty: leave the cube of them in one jump.
+    t_exit = _exit(ax, ay, az, bx, by, bz, block, fine_counts, ux, uy, uz, reach)
     if by_front:
         k_next = math.floor(t_exit / ds)
         while k_next > k:
@@ -193,8 +202,8 @@ def _preintegrated_ray(tent, data, flat, offset, gshape, inv, d, ax, ay, az, bx,
                        t_out, k, ds, k_first, k_last, t_first, t_last, fkind, fp0, fp1, fp2,
                        radius, ntaps, start, vinv, density, psi, emission, step, grey,
                        col_start, col_inv, mean, shade, ka, kd, ks, shininess, light,
-                       headlight, ramp_x, ramp_y, by_gradient, threshold, empty, coarse, block,
-                       fine_counts, coarse_counts, bound, budget):
+                       headlight, ramp_x, ramp_y, by_gradient, threshold, empty, clearance, block,
+                       fine_counts, bound, budget):
     """One ray, pre-integrated: each segment ``[k ds, (k + 1) ds)`` (cut at the volume's
     faces) classified from its values at its two ends (the back of one is the front of the
     next), front to back from segment ``k`` while its middle lies before ``t_out``. Returns
@@ -237,8 +246,8 @@ def _preintegrated_ray(tent, data, flat, offset, gshape, inv, d, ax, ay, az, bx,
         if t_a >= t_check:
             k_next, t_check, spent = _skip(
                 k, ax + t_a * bx, ay + t_a * by, az + t_a * bz, ax, ay, az, bx, by, bz, ds,
-                True, empty, coarse, block, fine_counts, coarse_counts, bound, budget, spent,
-                k_first, k_last, t_first, t_last)
+                True, empty, clearance, block, fine_counts, bound, budget, spent,
+                k_first, k_last, t_first, t_last, False)
             if k_next > k:
                 k = k_next
                 continue
@@ -348,11 +357,14 @@ def _pixel_start(r, c, camera, height, width, mask, out, box_lo, box_hi, vol_lo,
     if r >= height or c >= width:
         return (False, (0.0, 0.0, 0.0), 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, -1, -1,
                 0.0, 0.0)
-    o, d = pixel_ray(camera, height, width, r, c)
     out[r, c, 0] = 0.0
     out[r, c, 1] = 0.0
     out[r, c, 2] = 0.0
     out[r, c, 3] = 0.0
+    if not mask[r, c]:  # a ray that meets nothing visible: no set-up at all
+        return (False, (0.0, 0.0, 0.0), 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, -1, -1,
+                0.0, 0.0)
+    o, d = pixel_ray(camera, height, width, r, c)
     t_in, t_out = ray_box(o, d, box_lo, box_hi)
     t_in = max(t_in, 0.0)
     # Index position of sample k: a + t b, the same for every brick of a volume.
@@ -372,7 +384,7 @@ def _pixel_start(r, c, camera, height, width, mask, out, box_lo, box_hi, vol_lo,
         k_last = math.ceil(t_last / ds) - 1
         if k - 1 == k_first or k - 1 == k_last:
             k -= 1
-    hit = bool(mask[r, c]) and t_out > t_in
+    hit = t_out > t_in
     return hit, d, t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, t_first, t_last
 
 
@@ -382,7 +394,7 @@ def raycast_preintegrated(data, offset, gshape, origin, spacing, box_lo, box_hi,
                           ntaps, pre_start, pre_inv, pre_density, pre_psi, pre_emission,
                           pre_step, pre_grey, col_start, col_inv, pre_mean, shade, ka, kd, ks,
                           shininess, light, headlight, ramp_x, ramp_y, by_gradient, threshold,
-                          empty, coarse, block, mask, bound, budget, tile_h, tile_w, order,
+                          empty, clearance, block, mask, bound, budget, tile_h, tile_w, order,
                           out, samples):
     """:func:`raycast` with pre-integrated classification (a kernel of its own, so that a
     render compiles only the loop it runs): each segment is classified from its values at
@@ -397,25 +409,24 @@ def raycast_preintegrated(data, offset, gshape, origin, spacing, box_lo, box_hi,
     flat = data.reshape(-1)
     inv = 1.0 / spacing
     fine_counts = np.array(empty.shape)
-    coarse_counts = np.array(coarse.shape)
     for it in prange(order.shape[0]):
         tile_id = order[it]
         samples[tile_id] = _tile_preintegrated(
-            tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, origin,
+            tile_id, data, flat, inv, fine_counts, offset, gshape, origin,
             box_lo, box_hi, vol_lo, vol_hi, camera, height, width, ds, fkind, fp0, fp1, fp2,
             radius, ntaps, pre_start, pre_inv, pre_density, pre_psi, pre_emission, pre_step,
             pre_grey, col_start, col_inv, pre_mean, shade, ka, kd, ks, shininess, light,
-            headlight, ramp_x, ramp_y, by_gradient, threshold, empty, coarse, block, mask,
+            headlight, ramp_x, ramp_y, by_gradient, threshold, empty, clearance, block, mask,
             bound, budget, tile_h, tile_w, out)
 
 
 @jit
-def _tile_preintegrated(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape,
+def _tile_preintegrated(tile_id, data, flat, inv, fine_counts, offset, gshape,
                         origin, box_lo, box_hi, vol_lo, vol_hi, camera, height, width, ds,
                         fkind, fp0, fp1, fp2, radius, ntaps, pre_start, pre_inv, pre_density,
                         pre_psi, pre_emission, pre_step, pre_grey, col_start, col_inv,
                         pre_mean, shade, ka, kd, ks, shininess, light, headlight, ramp_x,
-                        ramp_y, by_gradient, threshold, empty, coarse, block, mask, bound,
+                        ramp_y, by_gradient, threshold, empty, clearance, block, mask, bound,
                         budget, tile_h, tile_w, out):
     """Tile ``tile_id`` of :func:`raycast_preintegrated` (the same arguments, as
     :func:`_tile`'s): its pixels' rays, front to back; returns the samples taken."""
@@ -438,16 +449,16 @@ def _tile_preintegrated(tile_id, data, flat, inv, fine_counts, coarse_counts, of
                 k, ds, k_first, k_last, t_first, t_last, fkind, fp0, fp1, fp2, radius, ntaps,
                 pre_start, pre_inv, pre_density, pre_psi, pre_emission, pre_step, pre_grey,
                 col_start, col_inv, pre_mean, shade, ka, kd, ks, shininess, light, headlight,
-                ramp_x, ramp_y, by_gradient, threshold, empty, coarse, block, fine_counts,
-                coarse_counts, bound, budget)
+                ramp_x, ramp_y, by_gradient, threshold, empty, clearance, block, fine_counts,
+                bound, budget)
         else:
             rgba = _preintegrated_ray(
                 False, data, flat, offset, gshape, inv, d, ax, ay, az, bx, by, bz, t_in, t_out,
                 k, ds, k_first, k_last, t_first, t_last, fkind, fp0, fp1, fp2, radius, ntaps,
                 pre_start, pre_inv, pre_density, pre_psi, pre_emission, pre_step, pre_grey,
                 col_start, col_inv, pre_mean, shade, ka, kd, ks, shininess, light, headlight,
-                ramp_x, ramp_y, by_gradient, threshold, empty, coarse, block, fine_counts,
-                coarse_counts, bound, budget)
+                ramp_x, ramp_y, by_gradient, threshold, empty, clearance, block, fine_counts,
+                bound, budget)
         out[r, c, 0] = rgba[0]
         out[r, c, 1] = rgba[1]
         out[r, c, 2] = rgba[2]
@@ -462,7 +473,7 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
             fkind, fp0, fp1, fp2, radius, ntaps,
             tstart, tinv, alpha_tab, color_tab, emit_tab,
             shade, ka, kd, ks, shininess, light, headlight, ramp_x, ramp_y, by_gradient,
-            threshold, empty, coarse, block, mask, bound, budget, multiplier, tile_h, tile_w,
+            threshold, empty, clearance, block, mask, bound, budget, multiplier, tile_h, tile_w,
             order, out, samples, grey, general, skipping):
     """Render ``out[row, col] = (r, g, b, a)`` premultiplied; count samples per tile.
 
@@ -477,12 +488,13 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
     not depend on the number of threads.
 
     Skips: ``empty`` flags blocks of ``block`` cells per axis that nothing visible can come
-    from, and ``coarse`` blocks of ``4 * block`` cells all of whose blocks are empty
-    (``block = 0`` turns skipping off), and ``mask`` the pixels whose rays can meet a
-    non-empty block; ``threshold = 1`` turns early ray termination off. With ``budget > 0``
-    a ray also skips blocks that are not empty while the bounds ``bound`` (per block: the
-    most a ray can change any channel by leaving the block out) of the blocks it skipped add
-    up to at most ``budget``: each pixel changes by at most ``budget``.
+    from, and ``clearance`` (per block, an integer array of the same shape) the Chebyshev
+    distance in blocks to the nearest block that is not empty (``block = 0`` turns skipping
+    off), and ``mask`` the pixels whose rays can meet a non-empty block; ``threshold = 1``
+    turns early ray termination off. With ``budget > 0`` a ray also skips blocks that are not
+    empty while the bounds ``bound`` (per block: the most a ray can change any channel by
+    leaving the block out) of the blocks it skipped add up to at most ``budget``: each pixel
+    changes by at most ``budget``.
     Adaptive steps: where ``multiplier`` (per block of the skip grid, a power of two; a
     ``(1, 1, 1)`` array of 1 turns them off) exceeds 1, one sample stands for that many
     segments (:func:`_long_segment`, :mod:`vrlib.adaptive`).
@@ -501,28 +513,27 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
     flat = data.reshape(-1)
     inv = 1.0 / spacing
     fine_counts = np.array(empty.shape)
-    coarse_counts = np.array(coarse.shape)
     for it in prange(order.shape[0]):
         tile_id = order[it]
         samples[tile_id] = _tile(
-            tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, origin,
+            tile_id, data, flat, inv, fine_counts, offset, gshape, origin,
             box_lo, box_hi, vol_lo, vol_hi, exact, camera, height, width,
             ds, fkind, fp0, fp1, fp2, radius, ntaps, tstart, tinv, alpha_tab, color_tab,
             emit_tab, shade, ka, kd, ks, shininess, light, headlight, ramp_x, ramp_y,
-            by_gradient, threshold, empty, coarse, block, mask, bound, budget, multiplier,
+            by_gradient, threshold, empty, clearance, block, mask, bound, budget, multiplier,
             tile_h, tile_w, out, grey, general, skipping)
 
 
 @jit
-def _tile(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, origin,
+def _tile(tile_id, data, flat, inv, fine_counts, offset, gshape, origin,
           box_lo, box_hi, vol_lo, vol_hi, exact, camera, height, width, ds, fkind, fp0, fp1, fp2,
           radius, ntaps, tstart, tinv, alpha_tab, color_tab, emit_tab, shade, ka, kd, ks,
-          shininess, light, headlight, ramp_x, ramp_y, by_gradient, threshold, empty, coarse,
+          shininess, light, headlight, ramp_x, ramp_y, by_gradient, threshold, empty, clearance,
           block, mask, bound, budget, multiplier, tile_h, tile_w, out, grey, general,
           skipping):
     """Tile ``tile_id`` of :func:`raycast` (the same arguments): its pixels' rays, front to
     back, in a fixed order; returns the samples taken. ``flat`` is ``data`` raveled, ``inv``
-    the inverse spacing, ``fine_counts`` and ``coarse_counts`` the skip grids' shapes."""
+    the inverse spacing, ``fine_counts`` the skip grid's shape."""
     tiles_across = (width + tile_w - 1) // tile_w
     nx = data.shape[2]
     nxy = data.shape[1] * data.shape[2]
@@ -598,9 +609,9 @@ def _tile(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, 
                 uz = az + t * bz
                 if skipping is not None and t >= t_check:
                     k_next, t_check, spent = _skip(
-                        k, ux, uy, uz, ax, ay, az, bx, by, bz, ds, False, empty, coarse,
-                        block, fine_counts, coarse_counts, bound, budget, spent, k_first,
-                        k_last, t_first, t_last)
+                        k, ux, uy, uz, ax, ay, az, bx, by, bz, ds, False, empty, clearance,
+                        block, fine_counts, bound, budget, spent, k_first,
+                        k_last, t_first, t_last, adaptive)
                     if k_next > k:
                         k = k_next
                         continue
@@ -683,3 +694,4 @@ def _tile(tile_id, data, flat, inv, fine_counts, coarse_counts, offset, gshape, 
         out[r, c, 2] = acc_b
         out[r, c, 3] = acc_a
     return taken
+

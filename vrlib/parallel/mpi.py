@@ -40,7 +40,7 @@ from vrlib.parallel.exchange import Exchange
 from vrlib.parallel.sources import RawFile, ghost, global_value_range, open_source
 from vrlib.parallel.stage import RankFailed, Stage
 from vrlib.raycast import cast_rays, segment_options
-from vrlib.skipping import BLOCK, brick_empty_blocks, coarsen, footprint_mask
+from vrlib.skipping import BLOCK, brick_empty_blocks, clearance, footprint_mask
 
 __all__ = ["render_object", "render_image", "RankFailed", "Frame", "visible_cells",
            "work_split", "COMPOSITORS", "RadixK", "RawFile", "BALANCE", "HEADER"]
@@ -99,7 +99,7 @@ def _cast(data, first, brick_lo, brick_hi, lattice, view, filt, transfer, ds, va
     return cast_rays(data, offset=tuple(first), global_shape=lattice.shape,
                      origin=lattice.origin, spacing=lattice.spacing, box=box, view=view,
                      filt=filt, transfer=transfer, ds=ds, value_range=value_range,
-                     early_termination=1.0, skip=(empty, coarsen(empty), BLOCK, mask),
+                     early_termination=1.0, skip=(empty, clearance(empty), BLOCK, mask),
                      exact_ends=exact_ends, preintegrated=preintegrated)
 
 
@@ -394,7 +394,7 @@ def render_image(comm, source, view, *, shape=None, extent=None, filter="triline
                 local, offset=tuple(lo), global_shape=lattice.shape, origin=lattice.origin,
                 spacing=lattice.spacing, box=lattice.box((0, 0, 0), lattice.cells), view=view,
                 filt=filt, transfer=transfer, ds=ds, value_range=value_range,
-                early_termination=1.0, skip=(skip_grid, coarsen(skip_grid), BLOCK, mask),
+                early_termination=1.0, skip=(skip_grid, clearance(skip_grid), BLOCK, mask),
                 exact_ends=exact, preintegrated=preint)
         render_s = time.perf_counter() - start
     rgba = gather_to_root(comm, [(r, rects.pixels(rgba, r)) for r in mine], view.shape, root,
