@@ -11,6 +11,7 @@ from naive import exact_blob_image, image_mass, random_orbits, raycast_naive
 import data_gen
 import vrlib
 from vrlib import Glow, LookupTransfer, Phong, View, Volume, metrics, render, render_reference
+from vrlib._kernels.queue import take
 from vrlib.parallel.sources import ghost as ghost_samples
 from vrlib.raycast import cast_rays
 from vrlib.value_bounds import reconstructed_range
@@ -177,6 +178,26 @@ def test_exact_segment_ends_converge_at_second_order():
     assert order["exact"] >= 1.8
     assert order["lattice"] < 1.2
     assert errors["exact"][0] * 5 < errors["lattice"][0]
+
+
+@numba.njit(parallel=True)
+def _take_all(counter, taken, threads):
+    for _ in numba.prange(threads):
+        while True:
+            item = take(counter)
+            if item >= taken.shape[0]:
+                break
+            taken[item] += 1
+
+
+def test_the_tile_queue_hands_out_every_item_once():
+    """The threads share the ray caster's tiles through one counter: each item is taken by
+    exactly one thread (an increment that is not atomic would hand some out twice)."""
+    taken = np.zeros(2_000_000, dtype=np.int64)
+    counter = np.zeros(1, dtype=np.int64)
+    _take_all(counter, taken, numba.get_num_threads())
+    assert (taken == 1).all()
+    assert counter[0] == taken.size + numba.get_num_threads()
 
 
 @pytest.mark.parametrize("options", [{}, {"segment_ends": "exact"},

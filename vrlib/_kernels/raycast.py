@@ -30,6 +30,7 @@ from vrlib._kernels._jit import jit, parallel_jit
 from vrlib._kernels.camera import pixel_ray, ray_box
 from vrlib._kernels.filters import CUBIC, TENT
 from vrlib._kernels.preintegration import bilinear_channel, psi_at
+from vrlib._kernels.queue import take
 from vrlib._kernels.sampling import (
     gradient,
     reconstruct,
@@ -344,9 +345,9 @@ def _step_segment(front, back, length, start, inv, density, emission, grey):
 
 
 @jit(inline="always")
-def _pixel_start(r, c, camera, height, width, mask, out, box_lo, box_hi, vol_lo, vol_hi,
-                 exact, origin, inv, ds):
-    """Pixel ``(r, c)``'s ray (cleared to transparent in ``out``) and where it takes samples:
+def _pixel_start(r, c, camera, height, width, mask, box_lo, box_hi, vol_lo, vol_hi, exact,
+                 origin, inv, ds):
+    """Pixel ``(r, c)``'s ray and where it takes samples:
     ``(hit, d, t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, t_first, t_last)``.
     ``hit`` is False for a pixel outside the image or the ``mask``, or a ray that misses the
     box ``[box_lo, box_hi]``; ``d`` is the ray's direction, ``[t_in, t_out)`` its stretch in
@@ -357,10 +358,6 @@ def _pixel_start(r, c, camera, height, width, mask, out, box_lo, box_hi, vol_lo,
     if r >= height or c >= width:
         return (False, (0.0, 0.0, 0.0), 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, -1, -1,
                 0.0, 0.0)
-    out[r, c, 0] = 0.0
-    out[r, c, 1] = 0.0
-    out[r, c, 2] = 0.0
-    out[r, c, 3] = 0.0
     if not mask[r, c]:  # a ray that meets nothing visible: no set-up at all
         return (False, (0.0, 0.0, 0.0), 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, -1, -1,
                 0.0, 0.0)
@@ -395,7 +392,7 @@ def raycast_preintegrated(data, offset, gshape, origin, spacing, box_lo, box_hi,
                           pre_step, pre_grey, col_start, col_inv, pre_mean, shade, ka, kd, ks,
                           shininess, light, headlight, ramp_x, ramp_y, by_gradient, threshold,
                           empty, clearance, block, mask, bound, budget, tile_h, tile_w, order,
-                          out, samples):
+                          threads, out, samples):
     """:func:`raycast` with pre-integrated classification (a kernel of its own, so that a
     render compiles only the loop it runs): each segment is classified from its values at
     its two ends (:func:`_preintegrated_ray`), always cut at the volume's faces. The
@@ -409,15 +406,20 @@ def raycast_preintegrated(data, offset, gshape, origin, spacing, box_lo, box_hi,
     flat = data.reshape(-1)
     inv = 1.0 / spacing
     fine_counts = np.array(empty.shape)
-    for it in prange(order.shape[0]):
-        tile_id = order[it]
-        samples[tile_id] = _tile_preintegrated(
-            tile_id, data, flat, inv, fine_counts, offset, gshape, origin,
-            box_lo, box_hi, vol_lo, vol_hi, camera, height, width, ds, fkind, fp0, fp1, fp2,
-            radius, ntaps, pre_start, pre_inv, pre_density, pre_psi, pre_emission, pre_step,
-            pre_grey, col_start, col_inv, pre_mean, shade, ka, kd, ks, shininess, light,
-            headlight, ramp_x, ramp_y, by_gradient, threshold, empty, clearance, block, mask,
-            bound, budget, tile_h, tile_w, out)
+    counter = np.zeros(1, np.int64)
+    for _ in prange(threads):
+        while True:
+            it = take(counter)
+            if it >= order.shape[0]:
+                break
+            tile_id = order[it]
+            samples[tile_id] = _tile_preintegrated(
+                tile_id, data, flat, inv, fine_counts, offset, gshape, origin,
+                box_lo, box_hi, vol_lo, vol_hi, camera, height, width, ds, fkind, fp0, fp1, fp2,
+                radius, ntaps, pre_start, pre_inv, pre_density, pre_psi, pre_emission, pre_step,
+                pre_grey, col_start, col_inv, pre_mean, shade, ka, kd, ks, shininess, light,
+                headlight, ramp_x, ramp_y, by_gradient, threshold, empty, clearance, block, mask,
+                bound, budget, tile_h, tile_w, out)
 
 
 @jit
@@ -438,7 +440,7 @@ def _tile_preintegrated(tile_id, data, flat, inv, fine_counts, offset, gshape,
         r = row0 + p // tile_w
         c = col0 + p % tile_w
         hit, d, t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, t_first, t_last = \
-            _pixel_start(r, c, camera, height, width, mask, out, box_lo, box_hi, vol_lo,
+            _pixel_start(r, c, camera, height, width, mask, box_lo, box_hi, vol_lo,
                          vol_hi, True, origin, inv, ds)
         if not hit:
             continue
@@ -474,18 +476,22 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
             tstart, tinv, alpha_tab, color_tab, emit_tab,
             shade, ka, kd, ks, shininess, light, headlight, ramp_x, ramp_y, by_gradient,
             threshold, empty, clearance, block, mask, bound, budget, multiplier, tile_h, tile_w,
-            order, out, samples, grey, general, skipping):
-    """Render ``out[row, col] = (r, g, b, a)`` premultiplied; count samples per tile.
+            order, threads, out, samples, grey, general, skipping):
+    """Render ``out[row, col] = (r, g, b, a)`` premultiplied (``out`` comes transparent: a
+    pixel whose ray meets nothing, and a tile left out of ``order``, stay so); count samples
+    per tile.
 
     ``data`` holds the samples from global index ``offset`` on (the whole volume, or a brick
     with ghost samples) of a volume of global shape ``gshape`` whose sample 0 is at world
     ``origin``; the rays of the packed view ``camera`` (one per pixel of a ``height x width``
     image) sample the world box ``[box_lo, box_hi]`` of a volume whose own box is
     ``[vol_lo, vol_hi]`` (cut exactly at its faces when ``exact``). The image is cut into
-    ``tile_h x tile_w`` pixel tiles, taken in the order ``order`` (spread over the image so that
-    threads share the work evenly); neighbouring rays read neighbouring voxels, so a tile keeps
-    them in cache. Each pixel is computed independently and in a fixed order: the image does
-    not depend on the number of threads.
+    ``tile_h x tile_w`` pixel tiles; each of ``threads`` threads takes the next tile of
+    ``order`` (the heaviest first) from a shared queue (:func:`vrlib._kernels.queue.take`)
+    until none is left, so that the threads finish together however unevenly the tiles
+    cost; neighbouring rays read neighbouring voxels, so a tile keeps them in cache. Each
+    pixel is computed independently and in a fixed order: the image depends neither on the
+    number of threads nor on which thread took which tile.
 
     Skips: ``empty`` flags blocks of ``block`` cells per axis that nothing visible can come
     from, and ``clearance`` (per block, an integer array of the same shape) the Chebyshev
@@ -513,15 +519,20 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
     flat = data.reshape(-1)
     inv = 1.0 / spacing
     fine_counts = np.array(empty.shape)
-    for it in prange(order.shape[0]):
-        tile_id = order[it]
-        samples[tile_id] = _tile(
-            tile_id, data, flat, inv, fine_counts, offset, gshape, origin,
-            box_lo, box_hi, vol_lo, vol_hi, exact, camera, height, width,
-            ds, fkind, fp0, fp1, fp2, radius, ntaps, tstart, tinv, alpha_tab, color_tab,
-            emit_tab, shade, ka, kd, ks, shininess, light, headlight, ramp_x, ramp_y,
-            by_gradient, threshold, empty, clearance, block, mask, bound, budget, multiplier,
-            tile_h, tile_w, out, grey, general, skipping)
+    counter = np.zeros(1, np.int64)
+    for _ in prange(threads):
+        while True:
+            it = take(counter)
+            if it >= order.shape[0]:
+                break
+            tile_id = order[it]
+            samples[tile_id] = _tile(
+                tile_id, data, flat, inv, fine_counts, offset, gshape, origin,
+                box_lo, box_hi, vol_lo, vol_hi, exact, camera, height, width,
+                ds, fkind, fp0, fp1, fp2, radius, ntaps, tstart, tinv, alpha_tab, color_tab,
+                emit_tab, shade, ka, kd, ks, shininess, light, headlight, ramp_x, ramp_y,
+                by_gradient, threshold, empty, clearance, block, mask, bound, budget, multiplier,
+                tile_h, tile_w, out, grey, general, skipping)
 
 
 @jit
@@ -549,7 +560,7 @@ def _tile(tile_id, data, flat, inv, fine_counts, offset, gshape, origin,
         r = row0 + p // tile_w
         c = col0 + p % tile_w
         hit, d, t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, t_first, t_last = \
-            _pixel_start(r, c, camera, height, width, mask, out, box_lo, box_hi, vol_lo,
+            _pixel_start(r, c, camera, height, width, mask, box_lo, box_hi, vol_lo,
                          vol_hi, exact, origin, inv, ds)
         if not hit:
             continue
