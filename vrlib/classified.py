@@ -28,7 +28,7 @@ import numpy as np
 from vrlib import validate
 from vrlib._kernels.classified import composite_classified, shade_table
 from vrlib._kernels.shear import warp
-from vrlib._scheduling import balanced_order, thread_count
+from vrlib._scheduling import thread_count
 from vrlib.arguments import check_transfer, framed_view
 from vrlib.colormapping import default_transfer
 from vrlib.filters import make_filter
@@ -231,9 +231,9 @@ class ClassifiedVolume:
         return factor, highlight
 
     def _band_order(self, axis, dj, height):
-        """Bands of :data:`BAND` intermediate rows in an order that shares them evenly among
-        threads, by the runs their scanlines hold (the middle slice's shift maps rows to
-        scanlines)."""
+        """Bands of :data:`BAND` intermediate rows, the heaviest first by the runs their
+        scanlines hold (the middle slice's shift maps rows to scanlines), for the threads'
+        shared queue."""
         if axis not in self._line_runs:
             run_ptr = self.encoding(axis)[0]
             n_k, n_j = _slice_shape(self.volume, axis)[:2]
@@ -242,7 +242,7 @@ class ClassifiedVolume:
         lines = np.clip(np.arange(height) + int(round(dj[dj.size // 2])), 0, runs.size - 1)
         cost = np.zeros(-(-height // BAND) * BAND)
         cost[:height] = runs[lines]
-        return balanced_order(cost.reshape(-1, BAND).sum(axis=1), numba.get_num_threads())
+        return np.argsort(-cost.reshape(-1, BAND).sum(axis=1), kind="stable")
 
     def render(self, view, *, early_termination=0.999, shading=None, threads=None):
         """Render an orthographic ``view`` (other arguments as :func:`vrlib.render`).
@@ -287,8 +287,8 @@ class ClassifiedVolume:
             counts = np.zeros(height, np.int64)
             composite_classified(*encoded, n_j, order, di, dj, length, self._emission, factor,
                                  highlight, self._grey, shading is not None, threshold, BAND,
-                                 self._band_order(axis, dj, height), inter,
-                                 counts)
+                                 self._band_order(axis, dj, height), numba.get_num_threads(),
+                                 inter, counts)
             plane = volume.origin[axis] + kf * volume.spacing[axis]
             out = np.empty(view.shape + (4,))
             warp(inter, warp_homography(view, volume, axis, plane, (oi, oj)), out, self._grey)

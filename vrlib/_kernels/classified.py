@@ -24,6 +24,7 @@ import numpy as np
 from numba import prange
 
 from vrlib._kernels._jit import jit, parallel_jit
+from vrlib._kernels.queue import take
 from vrlib._kernels.shading import half_vector, phong_terms
 
 
@@ -113,7 +114,7 @@ def _pair(v, w_left, w_right, sigma, emission_code, normal_code, emission, facto
 @parallel_jit
 def composite_classified(run_ptr, run_start, run_end, run_voxel, sigma, emission_code,
                          normal_code, n_j, order, di, dj, length, emission, factor, highlight,
-                         grey, shaded, threshold, band_rows, bands, inter, counts):
+                         grey, shaded, threshold, band_rows, bands, threads, inter, counts):
     """Composite the slices ``order`` (front to back) into ``inter[J, I] = (r, g, b, a)``.
 
     Slice ``k``'s sample for intermediate pixel ``(I, J)`` lies at column ``I + di[k]`` and row
@@ -125,119 +126,136 @@ def composite_classified(run_ptr, run_start, run_end, run_voxel, sigma, emission
     ``emission[e] * factor[n] + highlight[n]`` for its codes ``e`` and ``n`` (``grey``: white
     emission; unless ``shaded``, ``factor`` is 1 and ``highlight`` 0).
 
-    The image is cut into bands of ``band_rows`` rows, taken in the order ``bands`` (spread so
-    that threads share the work); a band walks the slices front to back and, in each, its rows
-    in order, so that it reads the encoding sequentially (VolPack's object order). Each row is
-    composited in a fixed order: the image does not depend on the thread count. ``counts[J]``
-    gets the samples row ``J`` composited.
+    The image is cut into bands of ``band_rows`` rows; each of ``threads`` threads takes the
+    next band of ``bands`` (the heaviest first) from a shared queue
+    (:func:`vrlib._kernels.queue.take`) until none is left. A band walks the slices front to
+    back and, in each, its rows in order, so that it reads the encoding sequentially
+    (VolPack's object order). Each row is composited in a fixed order: the image does not
+    depend on the thread count. ``counts[J]`` gets the samples row ``J`` composited.
     """
+    counter = np.zeros(1, np.int64)
+    for _ in prange(threads):
+        while True:
+            it = take(counter)
+            if it >= bands.shape[0]:
+                break
+            _composite_band(run_ptr, run_start, run_end, run_voxel, sigma, emission_code,
+                            normal_code, n_j, order, di, dj, length, emission, factor,
+                            highlight, grey, shaded, threshold, band_rows, bands[it], inter,
+                            counts)
+
+
+@jit
+def _composite_band(run_ptr, run_start, run_end, run_voxel, sigma, emission_code, normal_code,
+                    n_j, order, di, dj, length, emission, factor, highlight, grey, shaded,
+                    threshold, band_rows, band, inter, counts):
+    """Band ``band`` of :func:`composite_classified` (the same arguments)."""
     height, width = inter.shape[0], inter.shape[1]
-    for it in prange(bands.shape[0]):
-        first_row = bands[it] * band_rows
-        rows = min(band_rows, height - first_row)
-        links = np.empty((rows, width + 1), dtype=np.int64)
+    first_row = band * band_rows
+    rows = min(band_rows, height - first_row)
+    links = np.empty((rows, width + 1), dtype=np.int64)
+    for r in range(rows):
+        for i in range(width + 1):
+            links[r, i] = i
+    opaque = np.zeros(rows, dtype=np.int64)
+    taken = np.zeros(rows, dtype=np.int64)
+    for step in range(order.shape[0]):
+        k = order[step]
+        # The end slices stand for half a spacing (the volume's box ends there).
+        seg = 0.5 * length if step == 0 or step == order.shape[0] - 1 else length
+        s_i = math.floor(di[k])
+        fi = di[k] - s_i
+        before = 1 if fi > 0.0 else 0  # a voxel also feeds the pixel to its left
         for r in range(rows):
-            for i in range(width + 1):
-                links[r, i] = i
-        opaque = np.zeros(rows, dtype=np.int64)
-        taken = np.zeros(rows, dtype=np.int64)
-        for step in range(order.shape[0]):
-            k = order[step]
-            # The end slices stand for half a spacing (the volume's box ends there).
-            seg = 0.5 * length if step == 0 or step == order.shape[0] - 1 else length
-            s_i = math.floor(di[k])
-            fi = di[k] - s_i
-            before = 1 if fi > 0.0 else 0  # a voxel also feeds the pixel to its left
-            for r in range(rows):
-                if opaque[r] == width:
-                    continue
-                row = first_row + r
-                y = row + dj[k]
-                r0 = math.floor(y)
-                fj = y - r0
-                # Two streams, the scanlines around the row: r0 (weight 1 - fj), r0 + 1 (fj).
-                # A run [start, end) of either touches the pixels [start - s_i - before,
-                # end - s_i); the runs of one scanline touch disjoint pixels.
-                c0 = e0 = c1 = e1 = 0
-                if 0 <= r0 < n_j:
-                    c0 = run_ptr[k * n_j + r0]
-                    e0 = run_ptr[k * n_j + r0 + 1]
-                if fj > 0.0 and 0 <= r0 + 1 < n_j:
-                    c1 = run_ptr[k * n_j + r0 + 1]
-                    e1 = run_ptr[k * n_j + r0 + 2]
-                # The pixels the two scanlines touch at all; none open there: nothing to do.
-                lo = width
-                hi = 0
-                if c0 < e0:
-                    lo = min(lo, run_start[c0] - s_i - before)
-                    hi = max(hi, run_end[e0 - 1] - s_i)
-                if c1 < e1:
-                    lo = min(lo, run_start[c1] - s_i - before)
-                    hi = max(hi, run_end[e1 - 1] - s_i)
-                hi = min(hi, width)
-                if lo >= hi:
-                    continue
-                pos = _open(links, r, max(lo, 0))
+            if opaque[r] == width:
+                continue
+            row = first_row + r
+            y = row + dj[k]
+            r0 = math.floor(y)
+            fj = y - r0
+            # Two streams, the scanlines around the row: r0 (weight 1 - fj), r0 + 1 (fj).
+            # A run [start, end) of either touches the pixels [start - s_i - before,
+            # end - s_i); the runs of one scanline touch disjoint pixels.
+            c0 = e0 = c1 = e1 = 0
+            if 0 <= r0 < n_j:
+                c0 = run_ptr[k * n_j + r0]
+                e0 = run_ptr[k * n_j + r0 + 1]
+            if fj > 0.0 and 0 <= r0 + 1 < n_j:
+                c1 = run_ptr[k * n_j + r0 + 1]
+                e1 = run_ptr[k * n_j + r0 + 2]
+            # The pixels the two scanlines touch at all; none open there: nothing to do.
+            lo = width
+            hi = 0
+            if c0 < e0:
+                lo = min(lo, run_start[c0] - s_i - before)
+                hi = max(hi, run_end[e0 - 1] - s_i)
+            if c1 < e1:
+                lo = min(lo, run_start[c1] - s_i - before)
+                hi = max(hi, run_end[e1 - 1] - s_i)
+            hi = min(hi, width)
+            if lo >= hi:
+                continue
+            pos = _open(links, r, max(lo, 0))
+            if pos >= hi:
+                continue
+            w00 = (1.0 - fi) * (1.0 - fj)
+            w01 = fi * (1.0 - fj)
+            w10 = (1.0 - fi) * fj
+            w11 = fi * fj
+            # Walk the segments over which each stream stays inside one run or outside all:
+            # within one, a run's voxel for the pixel is base + pixel (VolPack's run
+            # merging), and the loop over the segment's open pixels keeps no books.
+            visited = 0
+            while True:
+                pos = _open(links, r, pos)  # past opaque pixels: their voxels are skipped
                 if pos >= hi:
-                    continue
-                w00 = (1.0 - fi) * (1.0 - fj)
-                w01 = fi * (1.0 - fj)
-                w10 = (1.0 - fi) * fj
-                w11 = fi * fj
-                # Walk the segments over which each stream stays inside one run or outside all:
-                # within one, a run's voxel for the pixel is base + pixel (VolPack's run
-                # merging), and the loop over the segment's open pixels keeps no books.
-                visited = 0
-                while True:
-                    pos = _open(links, r, pos)  # past opaque pixels: their voxels are skipped
-                    if pos >= hi:
-                        break
-                    following = hi
-                    c0, in0, base0, following = _stream(run_start, run_end, run_voxel, c0, e0,
-                                                        s_i, before, pos, following)
-                    c1, in1, base1, following = _stream(run_start, run_end, run_voxel, c1, e1,
-                                                        s_i, before, pos, following)
-                    if not (in0 or in1):
-                        pos = following
-                        continue
-                    pixel = pos
-                    while pixel < following:
-                        ext = cr = cg = cb = 0.0
-                        if in0:
-                            e, r_, g_, b_ = _pair(base0 + pixel, w00, w01, sigma, emission_code,
-                                                  normal_code, emission, factor, highlight, grey,
-                                                  shaded)
-                            ext += e
-                            cr += r_
-                            cg += g_
-                            cb += b_
-                        if in1:
-                            e, r_, g_, b_ = _pair(base1 + pixel, w10, w11, sigma, emission_code,
-                                                  normal_code, emission, factor, highlight, grey,
-                                                  shaded)
-                            ext += e
-                            cr += r_
-                            cg += g_
-                            cb += b_
-                        visited += 1
-                        if ext > 0.0:
-                            # Segment opacity (eq 1.4) and colour (eq 1.9), composited front to
-                            # back (eqs 1.7-1.8).
-                            alpha = _opacity(ext * seg)
-                            scale = alpha / ext
-                            cr *= scale
-                            cg = cr if grey else cg * scale
-                            cb = cr if grey else cb * scale
-                            remaining = 1.0 - inter[row, pixel, 3]
-                            inter[row, pixel, 0] += remaining * cr
-                            inter[row, pixel, 1] += remaining * cg
-                            inter[row, pixel, 2] += remaining * cb
-                            inter[row, pixel, 3] += remaining * alpha
-                            if inter[row, pixel, 3] >= threshold:
-                                links[r, pixel] = pixel + 1
-                                opaque[r] += 1
-                        pixel = _open(links, r, pixel + 1)
+                    break
+                following = hi
+                c0, in0, base0, following = _stream(run_start, run_end, run_voxel, c0, e0,
+                                                    s_i, before, pos, following)
+                c1, in1, base1, following = _stream(run_start, run_end, run_voxel, c1, e1,
+                                                    s_i, before, pos, following)
+                if not (in0 or in1):
                     pos = following
-                taken[r] += visited
-        for r in range(rows):
-            counts[first_row + r] = taken[r]
+                    continue
+                pixel = pos
+                while pixel < following:
+                    ext = cr = cg = cb = 0.0
+                    if in0:
+                        e, r_, g_, b_ = _pair(base0 + pixel, w00, w01, sigma, emission_code,
+                                              normal_code, emission, factor, highlight, grey,
+                                              shaded)
+                        ext += e
+                        cr += r_
+                        cg += g_
+                        cb += b_
+                    if in1:
+                        e, r_, g_, b_ = _pair(base1 + pixel, w10, w11, sigma, emission_code,
+                                              normal_code, emission, factor, highlight, grey,
+                                              shaded)
+                        ext += e
+                        cr += r_
+                        cg += g_
+                        cb += b_
+                    visited += 1
+                    if ext > 0.0:
+                        # Segment opacity (eq 1.4) and colour (eq 1.9), composited front to
+                        # back (eqs 1.7-1.8).
+                        alpha = _opacity(ext * seg)
+                        scale = alpha / ext
+                        cr *= scale
+                        cg = cr if grey else cg * scale
+                        cb = cr if grey else cb * scale
+                        remaining = 1.0 - inter[row, pixel, 3]
+                        inter[row, pixel, 0] += remaining * cr
+                        inter[row, pixel, 1] += remaining * cg
+                        inter[row, pixel, 2] += remaining * cb
+                        inter[row, pixel, 3] += remaining * alpha
+                        if inter[row, pixel, 3] >= threshold:
+                            links[r, pixel] = pixel + 1
+                            opaque[r] += 1
+                    pixel = _open(links, r, pixel + 1)
+                pos = following
+            taken[r] += visited
+    for r in range(rows):
+        counts[first_row + r] = taken[r]

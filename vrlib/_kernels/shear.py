@@ -471,14 +471,44 @@ def _warp_pixel(inter, x, y, out, row, c, grey):
         out[row, c, ch] = 0.0
 
 
+@jit(inline="always")
+def _columns_within(a, b, lo, hi, width):
+    """The columns ``c`` of ``[0, width)`` with ``lo <= a c + b <= hi``, widened by one
+    column each way (rounding): ``(first, stop)``, empty when ``first >= stop``."""
+    c0 = (lo - b) / a
+    c1 = (hi - b) / a
+    if a == 0.0 or not (c0 == c0 and c1 == c1):  # parallel to the box's sides, or NaN
+        return (0, width) if not lo > b and not b > hi else (0, 0)
+    if c0 > c1:
+        c0, c1 = c1, c0
+    c0 = min(max(c0, 0.0), float(width))  # clipped before the conversion to an integer
+    c1 = min(max(c1, -2.0), float(width))
+    return max(int(math.floor(c0)) - 1, 0), min(int(math.ceil(c1)) + 2, width)
+
+
 @parallel_jit
-def _warp_affine(inter, m, out, grey):
+def _warp_affine(inter, m, out, grey, seen):
+    """The affine warp (:func:`warp`) over the columns that can meet the intermediate
+    image's non-transparent box ``seen = (i_lo, i_hi, j_lo, j_hi)``; the rest of each row is
+    transparent without a look, as every pixel there reads four transparent neighbours."""
     height, width = out.shape[0], out.shape[1]
     for row in prange(height):
         ax = m[0, 1] * row + m[0, 2]
         ay = m[1, 1] * row + m[1, 2]
-        for c in range(width):
+        # A pixel reads columns int(x) and int(x) + 1: it can meet the box only for
+        # i_lo - 1 <= x < i_hi + 1 (and likewise for y).
+        x0, x1 = _columns_within(m[0, 0], ax, seen[0] - 1.0, seen[1] + 1.0, width)
+        y0, y1 = _columns_within(m[1, 0], ay, seen[2] - 1.0, seen[3] + 1.0, width)
+        first = max(x0, y0)
+        stop = max(min(x1, y1), first)
+        for c in range(first):
+            for ch in range(4):
+                out[row, c, ch] = 0.0
+        for c in range(first, stop):
             _warp_pixel(inter, m[0, 0] * c + ax, m[1, 0] * c + ay, out, row, c, grey)
+        for c in range(stop, width):
+            for ch in range(4):
+                out[row, c, ch] = 0.0
 
 
 @parallel_jit
@@ -502,6 +532,10 @@ def warp(inter, homography, out, grey=False):
     homography (orthographic views: ``D = 1``) takes no division; ``grey`` images (red, green
     and blue equal) interpolate one colour channel."""
     if homography[2, 0] == 0.0 and homography[2, 1] == 0.0 and homography[2, 2] == 1.0:
-        _warp_affine(inter, homography, out, grey)
+        cols = np.flatnonzero(inter[..., 3].any(axis=0))
+        rows = np.flatnonzero(inter[..., 3].any(axis=1))
+        seen = (np.array([cols[0], cols[-1], rows[0], rows[-1]], np.float64) if cols.size
+                else np.array([-3.0, -3.0, -3.0, -3.0]))  # nothing shows: no column meets it
+        _warp_affine(inter, homography, out, grey, seen)
     else:
         _warp_projective(inter, homography, out, grey)
