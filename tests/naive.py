@@ -593,12 +593,14 @@ def warp_naive(inter, volume, view, axis, q_axis, p_axis, kf, low):
     return np.clip(out, 0.0, 1.0)
 
 
-def shearwarp_naive(volume, view, filt, transfer):
+def shearwarp_naive(volume, view, filt, transfer, blend=None):
     """Shear-warp by the book: the intermediate image lies on the front slice's plane at its
     resolution; each of its pixels follows its ray (parallel, or from the eye) through every
     slice, resamples the slice where the ray meets it with the 2-D filter and composites front
     to back, each segment as long as the ray's path between slices (half on the end slices);
-    then the intermediate image is sampled bilinearly where each pixel's ray meets the plane."""
+    then the intermediate image is sampled bilinearly where each pixel's ray meets the plane.
+    With ``blend`` ("maximum" or "average") a pixel takes the largest or the mean of its
+    values instead, classified with the transfer function's unit distance, before the warp."""
     from vrlib.view import principal_axis
 
     axis, ascending = principal_axis(view, volume)
@@ -641,6 +643,7 @@ def shearwarp_naive(volume, view, filt, transfer):
     for big_j in range(height):
         for big_i in range(width):
             point = np.array([big_i, big_j], float) + low
+            values = []
             for k in (range(n_k) if ascending else range(n_k - 1, -1, -1)):
                 (i, j), length = hit(point, k)
                 if not (0 <= i <= n_i - 1 and 0 <= j <= n_j - 1):
@@ -649,6 +652,9 @@ def shearwarp_naive(volume, view, filt, transfer):
                 idx = math.floor(i - filt.radius) + 1 + np.arange(taps)
                 taps_at = np.ix_(np.clip(jdx, 0, n_j - 1), np.clip(idx, 0, n_i - 1))
                 value = filt(j - jdx) @ slices[k][taps_at] @ filt(i - idx)
+                if blend is not None:
+                    values.append(value)
+                    continue
                 part = 0.5 if k in (0, n_k - 1) else 1.0  # end slices reach half as far
                 density = transfer.opacity_density(np.array([value]))[0]
                 colour = transfer.emission(np.array([value]))[0]
@@ -663,6 +669,11 @@ def shearwarp_naive(volume, view, filt, transfer):
                 alpha = -np.expm1(-density * length * part)
                 inter[big_j, big_i] += (1 - inter[big_j, big_i, 3]) * np.r_[colour * alpha,
                                                                               alpha]
+            if blend is not None and values:
+                value = np.array([max(values) if blend == "maximum" else np.mean(values)])
+                unit = getattr(transfer, "unit_distance", volume.spacing.min())
+                alpha = -np.expm1(-transfer.opacity_density(value)[0] * unit)
+                inter[big_j, big_i] = np.r_[transfer.emission(value)[0] * alpha, alpha]
     return warp_naive(inter, volume, view, axis, q_axis, p_axis, kf, low)
 
 

@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+from naive import shearwarp_naive
 
 import data_gen
 import vrlib
@@ -83,11 +84,53 @@ def test_maximum_bounds_average_on_a_real_volume():
     assert top.rgba[..., 0].max() > 0.8 and mean.rgba[..., 0].max() < top.rgba[..., 0].max()
 
 
+@pytest.mark.parametrize("blend", ["maximum", "average"])
+@pytest.mark.parametrize("projection", ["orthographic", "perspective"])
+@pytest.mark.parametrize("filt", ["trilinear", "catmull-rom"])
+def test_shearwarp_projection_equals_its_naive_twin(blend, projection, filt):
+    """Shear-warp's projection: each intermediate pixel the max (mean) of the values its ray
+    resamples in the slices, classified, then warped; as the naive twin computes it."""
+    vol = FIELD.sample(10)
+    view = vrlib.View.orbit(azimuth=25, elevation=15, size=12, projection=projection,
+                            **({"distance": 3.0} if projection == "perspective" else {}))
+    tf = vrlib.colormap("viridis", [(0, 0.1), (1, 0.9)], clim=(0, 1), volume=vol)
+    img = vrlib.render(vol, view, method="shearwarp", filter=filt, transfer=tf, blend=blend)
+    twin = shearwarp_naive(vol, view, vrlib.make_filter(filt), tf, blend=blend)
+    np.testing.assert_allclose(img.rgba, twin, atol=1e-12)
+    assert (img.alpha > 0).sum() > 30
+
+
+@pytest.mark.parametrize("blend", ["maximum", "average"])
+@pytest.mark.parametrize("projection", ["orthographic", "perspective"])
+def test_shearwarp_projection_is_close_to_the_ray_casters(blend, projection):
+    """Against the ray caster's projection at a quarter-voxel step (48^3 blobs, 96^2, three
+    views): shear-warp samples only where its rays cross the slices and classifies before a
+    bilinear warp. Measured rmse of premultiplied RGBA, 2026-11-26: at most 3.5e-3 (maximum)
+    and 3.4e-4 (average); the ray caster at its default half-voxel step: 7e-4 and 5e-5. The
+    bound here is 2x the measured worst case; the images are the same for 1 and 2
+    threads."""
+    vol = data_gen.make_field("random-blobs", count=6, seed=7).sample(48)
+    tf = vrlib.colormap("viridis", [(0, 0), (0.2, 0), (1, 0.6)], volume=vol)
+    if blend == "average":
+        tf = vrlib.colormap("viridis", [(0, 0), (1, 1)], volume=vol)
+    for azimuth, elevation in [(35, 25), (0, 0), (120, -40)]:
+        view = vrlib.View.orbit(azimuth=azimuth, elevation=elevation, size=96,
+                                projection=projection)
+        reference = vrlib.render(vol, view, transfer=tf, blend=blend, step=0.25)
+        with thread_count(1):
+            one = vrlib.render(vol, view, method="shearwarp", transfer=tf, blend=blend)
+        two = vrlib.render(vol, view, method="shearwarp", transfer=tf, blend=blend)
+        np.testing.assert_array_equal(one.rgba, two.rgba)
+        assert vrlib.metrics.rmse(two, reference) < (7e-3 if blend == "maximum" else 7e-4)
+        assert reference.alpha.max() > (0.3 if blend == "maximum" else 0.1)
+
+
 def test_projections_refuse_what_they_cannot_do():
     vol = FIELD.sample(8)
     view = vrlib.View.orbit(size=4)
-    with pytest.raises(ValueError, match="use method='raycast'"):
-        vrlib.render(vol, view, method="splat", blend="maximum")
+    for method in ("splat", "shear3", "shear2"):
+        with pytest.raises(ValueError, match="use method='raycast' or method='shearwarp'"):
+            vrlib.render(vol, view, method=method, blend="maximum")
     with pytest.raises(ValueError, match="does not shade"):
         vrlib.render(vol, view, blend="average", transfer=vrlib.Glow(1, shading=vrlib.Phong()))
     with pytest.raises(ValueError, match="unknown blend 'mip'"):

@@ -1,4 +1,5 @@
-"""Maximum- and average-intensity projections: the ray caster's rays, one value per ray.
+"""Maximum- and average-intensity projections: the ray caster's rays, one value per ray
+(shear-warp projects its slices: :func:`vrlib.shearwarp.project_shearwarp`).
 
 Instead of emission-absorption compositing (eqs 1.7-1.8), a pixel takes the largest (MIP) or
 the mean value reconstructed along its ray, at the ray caster's sample positions and with any
@@ -22,10 +23,29 @@ from vrlib.image import Image, RenderStats
 from vrlib.prefilter import Tally, prepared
 from vrlib.raycast import operations_per_sample
 
-__all__ = ["render_projection", "BLENDS"]
+__all__ = ["render_projection", "classify_projected", "BLENDS"]
 
 #: Blend modes of :func:`vrlib.render`: compositing, or one value per ray.
 BLENDS = ("emission-absorption", "maximum", "average")
+
+
+def classify_projected(transfer, value, hit, spacing):
+    """Premultiplied RGBA of projected values (module docstring): colour ``E(v)``, opacity
+    ``1 - exp(-density(v) u)``, transparent where ``hit`` is False. Every method that
+    projects classifies with this.
+
+    Examples
+    --------
+    >>> from vrlib import Glow
+    >>> rgba = classify_projected(Glow(1.0), np.array([2.0, 2.0]), np.array([True, False]),
+    ...                           np.ones(3))
+    >>> np.round(rgba, 3).tolist()
+    [[0.865, 0.865, 0.865, 0.865], [0.0, 0.0, 0.0, 0.0]]
+    """
+    unit = getattr(transfer, "unit_distance", float(np.min(spacing)))
+    alpha = np.where(hit, -np.expm1(-transfer.opacity_density(value) * unit), 0.0)
+    return np.concatenate([transfer.emission(value) * alpha[..., None], alpha[..., None]],
+                          axis=-1)
 
 
 def render_projection(volume, view, *, filt, transfer, step, blend):
@@ -54,10 +74,7 @@ def render_projection(volume, view, *, filt, transfer, step, blend):
                     *filt.code, filt.radius, filt.taps,
                     _kernel.MAXIMUM if blend == "maximum" else _kernel.AVERAGE,
                     value, hit, samples)
-    unit = getattr(transfer, "unit_distance", float(volume.spacing.min()))
-    alpha = np.where(hit, -np.expm1(-transfer.opacity_density(value) * unit), 0.0)
-    rgba = np.concatenate([transfer.emission(value) * alpha[..., None], alpha[..., None]],
-                          axis=-1)
+    rgba = classify_projected(transfer, value, hit, volume.spacing)
     taken = int(samples.sum())
     # Per sample: the ray caster's position and reconstruction; a max or sum in place of
     # its classification and compositing.

@@ -13,7 +13,7 @@ from vrlib.projection import BLENDS, render_projection
 from vrlib.raycast import render_raycast
 from vrlib.reference import render_reference
 from vrlib.shear import render_shear2, render_shear3
-from vrlib.shearwarp import render_shearwarp
+from vrlib.shearwarp import project_shearwarp, render_shearwarp
 from vrlib.splat import render_splat
 from vrlib.tolerance import render_within
 from vrlib.volume import Volume
@@ -29,6 +29,17 @@ FINE = {"filter": "catmull-rom", "step": 0.125, "early_termination": 1.0}
 #: line and the cost model read this registry).
 METHODS = {"raycast": render_raycast, "splat": render_splat, "shear3": render_shear3,
            "shear2": render_shear2, "shearwarp": render_shearwarp}
+
+#: Why a method has no maximum- or average-intensity projection (said with the refusal).
+_WHY_NOT_PROJECTED = {
+    "splat": "a splat adds each voxel's footprint, integrated along the ray, into the image, "
+             "so what it holds per pixel is a sum over voxels, never the field's value at a "
+             "point of the ray, and its largest is not the field's maximum",
+    "shear3": "it would be shear-warp's projection after one or two more resampling passes, "
+              "slower and less accurate",
+    "shear2": "it would be shear-warp's projection after one more resampling pass, slower "
+              "and less accurate",
+}
 
 _COMMON = {"filt", "transfer", "step", "early_termination", "empty_space_skipping"}
 
@@ -83,7 +94,8 @@ def render(volume, view, *, method="raycast", filter="trilinear", transfer=None,
         the image.
     blend : {"emission-absorption", "maximum", "average"}
         Composite the samples front to back (the thesis's model), or project the largest or
-        the mean value along each ray (:mod:`vrlib.projection`; ray casting only, no shading).
+        the mean value along each ray (:mod:`vrlib.projection`; ray casting and shear-warp,
+        no shading).
     threads : int, optional
         Threads to use (default: numba's setting). The image does not depend on it.
     tolerance : float, optional
@@ -143,13 +155,18 @@ def render(volume, view, *, method="raycast", filter="trilinear", transfer=None,
         )
     validate.choice("blend", blend, BLENDS)
     if blend != "emission-absorption":
-        if method != "raycast":
-            raise ValueError(f"blend={blend!r} takes one value per ray, which ray casting "
-                             f"gives: use method='raycast' (not {method!r})")
+        if method not in ("raycast", "shearwarp"):
+            raise ValueError(
+                f"blend={blend!r} takes one value per ray, which ray casting and shear-warp "
+                f"give: use method='raycast' or method='shearwarp' (not {method!r}); "
+                + _WHY_NOT_PROJECTED.get(method, ""))
         refuse_gradients(transfer, f"blend={blend!r}", instead="blend='emission-absorption'")
         if options:
             raise TypeError(f"blend={blend!r} takes no method options, got {sorted(options)}")
         with thread_count(threads):
+            if method == "shearwarp":
+                return project_shearwarp(volume, view, filt=filt, transfer=transfer,
+                                         blend=blend)
             return render_projection(volume, view, filt=filt, transfer=transfer, step=step,
                                      blend=blend)
     if tolerance is not None:

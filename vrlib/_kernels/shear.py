@@ -444,6 +444,47 @@ def shear_slices(slices, order, scale, di, dj, fraction, fkind, fp0, fp1, fp2, r
         counts[big_j] = done
 
 
+@parallel_jit
+def project_slices(slices, order, scale, di, dj, fkind, fp0, fp1, fp2, radius, ntaps, maximum,
+                   value, count):
+    """Shear-warp's maximum- (``maximum``) or average-intensity projection into the
+    intermediate image: ``value[J, I]`` the largest, or the sum, of the values that
+    intermediate pixel ``(I, J)`` samples in the slices (at the same points, with the same
+    weights, as :func:`shear_slices`), ``count[J, I]`` how many (both zeros on entry). No
+    run is skipped: a projection's value may lie anywhere along the ray. Each task owns
+    intermediate rows and takes the slices in ``order``: the image does not depend on the
+    thread count."""
+    n_k, n_j, n_i = slices.shape
+    height, width = value.shape[0], value.shape[1]
+    for row in prange(height):
+        wi = np.empty(8)
+        wj = np.empty(8)
+        rows = np.empty(8, np.int64)
+        for step in range(n_k):
+            k = order[step]
+            s = scale[k]
+            j = s * row + dj[k]
+            if j < 0.0 or j > n_j - 1:
+                continue
+            j_first = int(math.floor(j - radius)) + 1
+            for b in range(ntaps):
+                wj[b] = weight(fkind, fp0, fp1, fp2, j - (j_first + b))
+                rows[b] = clamp(j_first + b, n_j)
+            big_first = max(0, int(math.ceil(-di[k] / s)))
+            big_last = min(width - 1, int(math.floor((n_i - 1.0 - di[k]) / s)))
+            for big_i in range(big_first, big_last + 1):
+                i = s * big_i + di[k]
+                i0 = int(math.floor(i - radius)) + 1
+                for a in range(ntaps):
+                    wi[a] = weight(fkind, fp0, fp1, fp2, i - (i0 + a))
+                v = _slice_sum(slices, k, rows, i0, ntaps, wi, wj)
+                if not maximum:
+                    value[row, big_i] += v
+                elif count[row, big_i] == 0 or v > value[row, big_i]:
+                    value[row, big_i] = v
+                count[row, big_i] += 1
+
+
 @jit(inline="always")
 def _warp_pixel(inter, x, y, out, row, c, grey):
     """``out[row, c]`` = ``inter`` sampled bilinearly at ``(x, y)``, clipped to [0, 1];
