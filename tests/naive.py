@@ -626,6 +626,12 @@ def shearwarp_naive(volume, view, filt, transfer, blend=None):
         d = (view.forward[axes] / h) if eye is None else np.r_[point, kf] - eye
         return point + d[:2] * (k - kf) / d[2], np.linalg.norm(d * h) / abs(d[2])
 
+    def to_eye(point):  # unit vector from the samples of point's ray back to the eye (world)
+        d = (view.forward[axes] / h) if eye is None else np.r_[point, kf] - eye
+        world = np.empty(3)
+        world[axes] = d * h
+        return -world / np.linalg.norm(world)
+
     # Plane extent: the end slices' corners projected back onto the plane.
     ext = []
     for k in (0, n_k - 1):
@@ -664,8 +670,9 @@ def shearwarp_naive(volume, view, filt, transfer, blend=None):
                     if transfer.gradient_opacity is not None:
                         density *= transfer.gradient_opacity.factor(np.linalg.norm(grad))
                     if transfer.shading is not None:
-                        colour = (colour * transfer.shading.factor(grad, -view.forward)
-                                  + transfer.shading.highlight(grad, -view.forward))
+                        back = to_eye(point)
+                        colour = (colour * transfer.shading.factor(grad, back)
+                                  + transfer.shading.highlight(grad, back))
                 alpha = -np.expm1(-density * length * part)
                 inter[big_j, big_i] += (1 - inter[big_j, big_i, 3]) * np.r_[colour * alpha,
                                                                               alpha]

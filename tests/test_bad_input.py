@@ -80,9 +80,6 @@ CASES = [
     ("transfer not a transfer", lambda: render(transfer=lambda v: v), TypeError, r"transfer"),
     ("perspective shear3", lambda: render(method="shear3", view=View.orbit(
         size=8, projection="perspective")), ValueError, r"orthographic only"),
-    ("shaded perspective shear-warp", lambda: render(
-        method="shearwarp", view=View.orbit(size=8, projection="perspective"),
-        transfer=Glow(1.0, shading=vrlib.Phong())), ValueError, r"does not shade"),
     ("shaded sheet splatting", lambda: render(method="splat",
                                               transfer=Glow(1.0, shading=vrlib.Phong())),
      ValueError, r"does not shade"),

@@ -70,15 +70,11 @@ def test_shearwarp_matches_naive_twin(filt, transfer, azimuth, elevation):
 @pytest.mark.parametrize("projection", ["orthographic", "perspective"])
 def test_shearwarp_with_gradients_matches_naive_twin(filt, transfer, projection):
     """Shear-warp classifies each sample by its gradient too (the slices' central differences,
-    resampled with the same 2-D weights); perspective views take gradient opacity, and refuse
-    shading (a ray direction per pixel is not implemented)."""
+    resampled with the same 2-D weights); a perspective view shades each intermediate pixel's
+    samples along that pixel's own ray."""
     vol = small_volume()
     view = View.orbit(azimuth=120, elevation=50, size=(7, 9), projection=projection,
                       distance=4.0 if projection == "perspective" else None)
-    if projection == "perspective" and transfer.shading is not None:
-        with pytest.raises(ValueError, match="perspective shear-warp does not shade"):
-            render(vol, view, method="shearwarp", filter=filt, transfer=transfer)
-        return
     fast = render(vol, view, method="shearwarp", filter=filt, transfer=transfer,
                   early_termination=1.0)
     slow = shearwarp_naive(vol, view, vrlib.make_filter(filt), transfer)
@@ -99,6 +95,24 @@ def test_perspective_shearwarp_matches_naive_twin(filt, azimuth, elevation, dist
     slow = shearwarp_naive(vol, view, vrlib.make_filter(filt), Glow(3.0))
     np.testing.assert_allclose(fast.rgba, slow, atol=1e-6)
     assert fast.alpha.max() > 0.02
+
+
+def test_perspective_shaded_shearwarp_is_close_to_the_ray_casters():
+    """Perspective shading (each intermediate pixel's own ray) against the ray caster at a
+    quarter-voxel step: six blobs 48^3 -> 96^2 under a shaded colour table, four views.
+    Measured rmse of premultiplied RGBA, 2026-11-26: 4.5e-3 to 5.2e-3 (orthographic
+    shear-warp 3.2e-3 to 4.8e-3; the ray caster at one voxel 0.7e-3 to 1.7e-3: shear-warp
+    samples once per slice and warps). The bound is 2x the measured worst case."""
+    vol = data_gen.make_field("random-blobs", count=6, seed=7).sample(48)
+    lit = vrlib.colormap("viridis", [(0, 0), (0.2, 0), (1, 0.6)], volume=vol,
+                         shading=vrlib.Phong(specular=0.3))
+    for azimuth, elevation in [(35, 25), (0, 0), (120, -40), (-70, 60)]:
+        view = View.orbit(azimuth=azimuth, elevation=elevation, size=96,
+                          projection="perspective")
+        reference = render(vol, view, transfer=lit, step=0.25)
+        image = render(vol, view, method="shearwarp", transfer=lit)
+        assert vrlib.metrics.rmse(image, reference) < 1.05e-2
+        assert reference.alpha.max() > 0.9
 
 
 def test_perspective_shearwarp_against_reference():

@@ -7,10 +7,10 @@ composited front to back into an intermediate image at the front slice's resolut
 intermediate image is then warped to the final one with bilinear interpolation. Runs of
 transparent voxels are skipped (:func:`vrlib.skipping.transparent_runs`), Lacroute's
 run-length encoding. Transfer functions that need gradients (shading, gradient opacity) take the
-samples' central differences resampled with the same weights (:mod:`vrlib.gradients`);
-perspective views take gradient opacity but not shading (one ray direction per intermediate
-pixel is not implemented). :func:`vrlib.classify` is VolPack's form of the method, with
-classification and shading before resampling.
+samples' central differences resampled with the same weights (:mod:`vrlib.gradients`); a
+perspective view shades each intermediate pixel's samples along its own ray.
+:func:`vrlib.classify` is VolPack's form of the method, with classification and shading before
+resampling.
 """
 
 from __future__ import annotations
@@ -23,7 +23,6 @@ import numpy as np
 from vrlib import validate
 from vrlib._kernels import shear as _kernel
 from vrlib._kernels._jit import readonly
-from vrlib.arguments import refuse_gradients
 from vrlib.gradients import kernel_lighting, no_gradients
 from vrlib.image import Image, RenderStats
 from vrlib.prefilter import Tally, prepared, prepared_gradients
@@ -149,9 +148,6 @@ def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
     """
     min_opacity = validate.finite_number("min_opacity", min_opacity, low=0.0, high=1.0,
                                           high_open=True)
-    if view.is_perspective and transfer.shading is not None:
-        refuse_gradients(transfer, "perspective shear-warp", "an orthographic view, "
-                         "method='raycast' or method='splat' with mode='direct'")
     ntaps = filt.taps
     start = time.perf_counter()
     axis, ascending = principal_axis(view, volume)
@@ -177,9 +173,17 @@ def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
     length = float(segment(rays(centre[None])[0]))
     if not view.is_perspective:
         fraction = np.ones((1, 1))
+        directions = view.forward.reshape(1, 1, 3)
     else:
         grid = np.stack(np.meshgrid(np.arange(width) - oi, np.arange(height) - oj), -1)
         fraction = segment(rays(grid)) / length
+        # Each intermediate pixel's ray, in world units (x, y, z), for shading.
+        directions = np.empty((height, width, 3)) if transfer.shading is not None else \
+            view.forward.reshape(1, 1, 3)
+        if transfer.shading is not None:
+            for column, a in enumerate((q_axis, p_axis, axis)):
+                directions[..., a] = rays(grid)[..., column] * h[a]
+            directions /= np.linalg.norm(directions, axis=-1, keepdims=True)
     low, high = reconstructed_range(volume, filt)
     tables = transfer.segment_table(length, low, high)
     bound = -math.inf
@@ -194,7 +198,8 @@ def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
             {2: (0, 1, 2, 3), 1: (0, 2, 1, 3), 0: (0, 3, 1, 2)}[axis])
     _kernel.shear_slices(slices, order, scale, di, dj, fraction, *filt.code, filt.radius,
                          ntaps, *tables, grads, *kernel_lighting(transfer, view.forward),
-                         early_termination, readonly(first), readonly(last), inter, counts)
+                         np.ascontiguousarray(directions, np.float64), early_termination,
+                         readonly(first), readonly(last), inter, counts)
     # The warp: where each pixel's ray meets the front slice, in intermediate coordinates.
     plane = volume.origin[axis] + kf * h[axis]
     out = np.empty(view.shape + (4,))

@@ -188,16 +188,19 @@ def _inside_range(inverse, shift, limits, x, y, n):
 
 @jit
 def _over_lit(value, fraction, gx, gy, gz, tstart, tinv, alpha_tab, emit_tab, lit, ramp_x,
-              ramp_y, buf, y, x):
+              ramp_y, buf, y, x, dx, dy, dz):
     """:func:`_over` for a sample classified by its gradient ``g`` too (shading, gradient
-    opacity; ``lit``, ``ramp_x``, ``ramp_y`` from :func:`vrlib.gradients.kernel_lighting`)."""
+    opacity; ``lit``, ``ramp_x``, ``ramp_y`` from :func:`vrlib.gradients.kernel_lighting`),
+    seen along the unit ray direction ``d`` (``lit[10:13]`` for an orthographic view; a
+    headlight shines along ``-d``)."""
     i, w = lookup((value - tstart) * tinv, alpha_tab.shape[0])
     alpha = alpha_tab[i] + w * (alpha_tab[i + 1] - alpha_tab[i])
     if not alpha > 0.0:
         return
+    lx, ly, lz = (-dx, -dy, -dz) if lit[1] != 0.0 else (lit[7], lit[8], lit[9])
     alpha, cr, cg, cb = classify_by_gradient(
         alpha, i, w, emit_tab, gx, gy, gz, lit[2] != 0.0, ramp_x, ramp_y, lit[0] != 0.0,
-        lit[7], lit[8], lit[9], lit[10], lit[11], lit[12], lit[3], lit[4], lit[5], lit[6])
+        lx, ly, lz, dx, dy, dz, lit[3], lit[4], lit[5], lit[6])
     if not alpha > 0.0:
         return
     if fraction != 1.0:
@@ -283,7 +286,7 @@ def resample_composite(src, c0, c1, c2, offset, line_lo, line_hi, fkind, fp0, fp
                 done += 1
                 if lighting:
                     _over_lit(value, 1.0, gx, gy, gz, tstart, tinv, alpha_tab, emit_tab, lit,
-                              ramp_x, ramp_y, out, y, x)
+                              ramp_x, ramp_y, out, y, x, lit[10], lit[11], lit[12])
                 else:
                     _over(value, 1.0, tstart, tinv, alpha_tab, color_tab, out, y, x)
         resampled[y] = taken
@@ -338,7 +341,7 @@ def composite_slices(vol, front_to_back, inverse2, shift, limits, tstart, tinv, 
                 if lighting:
                     _over_lit(vol[w, y, x], end, grads[0, w, y, x], grads[1, w, y, x],
                               grads[2, w, y, x], tstart, tinv, alpha_tab, emit_tab, lit,
-                              ramp_x, ramp_y, out, y, x)
+                              ramp_x, ramp_y, out, y, x, lit[10], lit[11], lit[12])
                 else:
                     _over(vol[w, y, x], end, tstart, tinv, alpha_tab, color_tab, out, y, x)
         counts[y] = done
@@ -368,7 +371,7 @@ def _slice_sum(slices, k, rows, i0, ntaps, wi, wj):
 @parallel_jit
 def shear_slices(slices, order, scale, di, dj, fraction, fkind, fp0, fp1, fp2, radius, ntaps,
                  tstart, tinv, alpha_tab, color_tab, emit_tab, grads, lit, ramp_x, ramp_y,
-                 threshold, first, last, inter, counts):
+                 rays, threshold, first, last, inter, counts):
     """Shear-warp's compositing into the intermediate image (Lacroute and Levoy 1994).
 
     ``slices[k, j, i]`` is the volume in slice order. Intermediate pixel ``(I, J)`` samples
@@ -381,7 +384,9 @@ def shear_slices(slices, order, scale, di, dj, fraction, fkind, fp0, fp1, fp2, r
     columns ``first[k, j] .. last[k, j]``; pixels whose opacity has reached ``threshold`` take
     no more. Each task owns intermediate rows: no races. With ``grads`` (``[3, k, j, i]``, the
     gradient's components in slice order; ``no_gradients()`` for none) each sample's gradient is
-    resampled with the same weights and the sample classified by it too (:func:`_over_lit`).
+    resampled with the same weights and the sample classified by it too (:func:`_over_lit`),
+    seen along ``rays[J, I]`` (world unit directions, shape ``(1, 1, 3)``: the view's one
+    direction).
     """
     lighting = lit[0] != 0.0 or lit[2] != 0.0  # shading or gradient opacity
     n_k, n_j, n_i = slices.shape
@@ -435,10 +440,14 @@ def shear_slices(slices, order, scale, di, dj, fraction, fkind, fp0, fp1, fp2, r
                 done += 1
                 part = end if uniform else end * fraction[big_j, big_i]
                 if lighting:
+                    # Perspective: each intermediate pixel's own ray direction.
+                    ray_j, ray_i = (0, 0) if rays.shape[0] == 1 else (big_j, big_i)
                     _over_lit(value, part, _slice_sum(grads[0], k, rows, i0, ntaps, wi, wj),
                               _slice_sum(grads[1], k, rows, i0, ntaps, wi, wj),
                               _slice_sum(grads[2], k, rows, i0, ntaps, wi, wj), tstart, tinv,
-                              alpha_tab, emit_tab, lit, ramp_x, ramp_y, inter, big_j, big_i)
+                              alpha_tab, emit_tab, lit, ramp_x, ramp_y, inter, big_j, big_i,
+                              rays[ray_j, ray_i, 0], rays[ray_j, ray_i, 1],
+                              rays[ray_j, ray_i, 2])
                 else:
                     _over(value, part, tstart, tinv, alpha_tab, color_tab, inter, big_j, big_i)
         counts[big_j] = done
