@@ -333,11 +333,22 @@ def splat_naive(volume, view, filt, transfer, mode, slab_width=1.0):
     slice). ``"image-aligned"``: slabs of camera depth, each voxel adding its line integral's
     part inside the slab and the box, classified over the slab's in-box stretch.
     ``"direct"``: each voxel composited at once, ``1 - exp(-density(f_i) FP)``, colour
-    ``E(f_i)``.
+    ``E(f_i)``. A sheet mode with a transfer function that needs gradients sums each voxel's
+    central-difference gradient (prefiltered as the values are) with the same footprints,
+    and classifies each segment by its mean gradient too, seen along the pixel's ray.
     """
     from vrlib.footprint import footprint, running_integral, slanted
     from vrlib.view import principal_axis
 
+    lighting = transfer.needs_gradient and mode != "direct"
+    if lighting:
+        field = np.asarray(volume.data, float)
+        hx, hy, hz = volume.spacing
+        # (held in float32, as vrlib.gradients stores them, before and after prefiltering)
+        grads = [prefilter_naive(g.astype(np.float32).astype(float), filt,
+                                 (0, 1, 2)).astype(np.float32).astype(float) for g in (
+            np.gradient(field, hx, axis=2), np.gradient(field, hy, axis=1),
+            np.gradient(field, hz, axis=0))]
     volume = coefficient_volume_naive(volume, filt)
     axis, ascending = principal_axis(view, volume)
     spacing = volume.spacing
@@ -370,6 +381,10 @@ def splat_naive(volume, view, filt, transfer, mode, slab_width=1.0):
         i, j, k = (min(max(ijk[a], 0), counts[a] - 1) for a in range(3))
         return data[k, j, i]
 
+    def gradient_at(ijk):
+        i, j, k = (min(max(ijk[a], 0), counts[a] - 1) for a in range(3))
+        return np.array([g[k, j, i] for g in grads])
+
     def footprint_of(ijk, lo, hi):
         """The voxel's line integral on every ray between ray parameters ``lo`` and ``hi``
         (a rim voxel's clipped to the box)."""
@@ -388,9 +403,19 @@ def splat_naive(volume, view, filt, transfer, mode, slab_width=1.0):
                                  hi)
 
     def composite(value, length, where):
-        alpha = -np.expm1(-transfer.opacity_density(value) * length)
-        segment = np.concatenate([transfer.emission(value) * alpha[..., None],
-                                  alpha[..., None]], -1)
+        density = transfer.opacity_density(value)
+        colour = transfer.emission(value)
+        if lighting:
+            with np.errstate(divide="ignore", invalid="ignore"):
+                grad = gsheet / np.where(where, length, 1.0)[..., None]
+            if transfer.gradient_opacity is not None:
+                density = density * transfer.gradient_opacity.factor(
+                    np.linalg.norm(grad, axis=-1))
+            if transfer.shading is not None:
+                colour = (colour * transfer.shading.factor(grad, -directions)[..., None]
+                          + transfer.shading.highlight(grad, -directions)[..., None])
+        alpha = -np.expm1(-density * length)
+        segment = np.concatenate([colour * alpha[..., None], alpha[..., None]], -1)
         return np.where(where[..., None], image + (1.0 - image[..., 3:4]) * segment, image)
 
     order = range(-ghost, counts[axis] + ghost)
@@ -398,6 +423,7 @@ def splat_naive(volume, view, filt, transfer, mode, slab_width=1.0):
     # A pixel a nonzero voxel drew on is "touched"; only touched pixels are classified, and
     # one stays touched while its sheet is held.
     sheet, touched = np.zeros(view.shape), np.zeros(view.shape, bool)
+    gsheet = np.zeros(view.shape + (3,))
     if mode == "image-aligned":
         corners = np.array(np.meshgrid(*volume.extent, indexing="ij")).reshape(3, -1).T
         depths = view.to_camera(corners)[:, 2]
@@ -413,6 +439,8 @@ def splat_naive(volume, view, filt, transfer, mode, slab_width=1.0):
                     f = value_at(ijk)
                     weight = footprint_of(ijk, lo, hi)
                     sheet += f * weight
+                    if lighting:
+                        gsheet += gradient_at(ijk) * weight[..., None]
                     touched |= (f != 0.0) & (weight != 0.0)
             held_length += np.where(touched & (hi - lo > 0), hi - lo, 0.0)
             # A stretch under a quarter of the slab is held until the ray leaves the box.
@@ -421,6 +449,7 @@ def splat_naive(volume, view, filt, transfer, mode, slab_width=1.0):
             value = np.where(ready, sheet / np.where(ready, held_length, 1.0), 0.0)
             image = composite(value, held_length, ready)
             sheet, touched = np.where(ready, 0.0, sheet), touched & ~ready
+            gsheet = np.where(ready[..., None], 0.0, gsheet)
             held_length = np.where(ready, 0.0, held_length)
     else:
         slab = spacing[axis] / np.abs(directions[..., axis])
@@ -432,6 +461,8 @@ def splat_naive(volume, view, filt, transfer, mode, slab_width=1.0):
                 weight = footprint_of(ijk, -np.inf, np.inf)
                 if mode == "sheet":
                     sheet += f * weight
+                    if lighting:
+                        gsheet += gradient_at(ijk) * weight[..., None]
                     touched |= (f != 0.0) & (weight != 0.0)
                     continue
                 dens = float(transfer.opacity_density(np.array([f]))[0])
@@ -462,6 +493,7 @@ def splat_naive(volume, view, filt, transfer, mode, slab_width=1.0):
             value = np.where(ready, sheet / np.where(ready, length, 1.0), 0.0)
             image = composite(value, length, ready)
             sheet, touched = np.where(ready, 0.0, sheet), touched & ~ready
+            gsheet = np.where(ready[..., None], 0.0, gsheet)
             held_length = np.where(ready, 0.0, held_length)
             last_length = np.where(ready, length, last_length)
     image = np.maximum(image, 0.0)  # negative lobes: clamped to transparent black

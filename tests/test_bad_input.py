@@ -80,9 +80,6 @@ CASES = [
     ("transfer not a transfer", lambda: render(transfer=lambda v: v), TypeError, r"transfer"),
     ("perspective shear3", lambda: render(method="shear3", view=View.orbit(
         size=8, projection="perspective")), ValueError, r"orthographic only"),
-    ("shaded sheet splatting", lambda: render(method="splat",
-                                              transfer=Glow(1.0, shading=vrlib.Phong())),
-     ValueError, r"does not shade"),
     ("filter too wide for ray casting", lambda: render(filter=("gaussian", 2.0, 5.0)),
      ValueError, r"radius"),
     # filters and transfer functions

@@ -185,18 +185,6 @@ def test_a_ramp_of_ones_changes_nothing():
         assert np.array_equal(base.rgba, same.rgba)
 
 
-def test_sheet_splatting_refuses_gradients():
-    """Sheet buffers classify reconstructed sums, which carry no gradient: they refuse shading
-    and gradient opacity and name what takes them."""
-    volume = data_gen.make_field("gaussian-blob", sigma=0.3).sample(8)
-    transfer = vrlib.Glow(1.0, gradient_opacity=vrlib.GradientOpacity([0, 1], [0, 1]))
-    with pytest.raises(ValueError, match="gradient_opacity.*mode='direct'.*raycast"):
-        vrlib.render(volume, vrlib.View.orbit(size=8), method="splat", transfer=transfer)
-    with pytest.raises(ValueError, match="sheet buffers does not shade"):
-        vrlib.render(volume, vrlib.View.orbit(size=8), method="splat",
-                     transfer=vrlib.Glow(1.0, shading=vrlib.Phong()))
-
-
 SHADED = vrlib.Glow(3.0, shading=vrlib.Phong(specular=0.3, light=[0.0, 0.6, 0.8]),
                     gradient_opacity=vrlib.GradientOpacity([0.0, 2.0], [0.3, 1.0]))
 

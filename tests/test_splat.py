@@ -161,6 +161,55 @@ def test_kernel_matches_naive_twin(projection, filt, mode, transfer):
     assert fast.alpha.max() > 0.1
 
 
+SHADED = LookupTransfer([0.0, 3.0, 1.0, 5.0], [[1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 1]],
+                        shading=Phong(specular=0.4),
+                        gradient_opacity=vrlib.GradientOpacity([0.0, 2.0], [0.2, 1.0]))
+
+
+@pytest.mark.parametrize("projection", ["orthographic", "perspective"])
+@pytest.mark.parametrize("filt, mode", [("trilinear", "sheet"), ("catmull-rom", "sheet"),
+                                        ("omoms", "sheet"), ("trilinear", "image-aligned")])
+def test_shaded_sheets_match_naive_twin(projection, filt, mode):
+    """Sheet buffers shade: each voxel's central-difference gradient is splatted beside its
+    value, and each segment is classified by its mean gradient (gradient opacity) and shaded
+    along the pixel's own ray (a headlight), as the twin computes it."""
+    vol = small_volume()
+    view = View.orbit(azimuth=33, elevation=-21, size=(7, 9), projection=projection)
+    fast = render(vol, view, method="splat", filter=filt, transfer=SHADED, mode=mode,
+                  early_termination=1.0)
+    slow = splat_naive(vol, view, vrlib.make_filter(filt), SHADED, mode)
+    np.testing.assert_allclose(fast.rgba, slow, atol=1e-6)
+    assert fast.alpha.max() > 0.1
+    plain = splat_naive(vol, view, vrlib.make_filter(filt), TABLE, mode)
+    assert np.abs(fast.rgba - plain).max() > 0.05  # the shading and the ramp show
+
+
+@pytest.mark.parametrize("projection", ["orthographic", "perspective"])
+def test_shaded_sheets_are_close_to_the_ray_casters(projection):
+    """Against the ray caster at a quarter-voxel step: six blobs 48^3 -> 96^2, a shaded
+    colour table and a gradient-opacity one, three views. Measured rmse of premultiplied
+    RGBA, 2026-11-26: sheets 0.7e-3 to 4.5e-3, image-aligned sheets 0.7e-3 to 3.4e-3, direct
+    splatting 4.3e-3 to 6.0e-3 (it classifies before reconstructing). The bound is 2x the
+    sheets' measured worst case; the images are the same for 1 and 2 threads."""
+    vol = data_gen.make_field("random-blobs", count=6, seed=7).sample(48)
+    points = [(0, 0), (0.2, 0), (1, 0.6)]
+    transfers = [vrlib.colormap("viridis", points, volume=vol,
+                                shading=Phong(specular=0.3)),
+                 vrlib.colormap("viridis", points, volume=vol,
+                                gradient_opacity=vrlib.GradientOpacity([0.0, 2.0], [0.0, 1.0]))]
+    for transfer in transfers:
+        for azimuth, elevation in [(35, 25), (0, 0), (120, -40)]:
+            view = View.orbit(azimuth=azimuth, elevation=elevation, size=96,
+                              projection=projection)
+            reference = render(vol, view, transfer=transfer, step=0.25)
+            for mode in ("sheet", "image-aligned"):
+                image = render(vol, view, method="splat", transfer=transfer, mode=mode)
+                assert metrics.rmse(image, reference) < 9e-3
+            one = render(vol, view, method="splat", transfer=transfer, threads=1)
+            two = render(vol, view, method="splat", transfer=transfer, threads=2)
+            assert np.array_equal(one.rgba, two.rgba)
+
+
 @pytest.mark.parametrize("projection", ["orthographic", "perspective"])
 def test_prefiltered_sheets_match_naive_twin(projection):
     """A prefiltered filter splats the volume's coefficients (the twin solves for them) with
@@ -400,8 +449,6 @@ def test_principal_axis_and_order():
         ({"filter": ("gaussian", -0.5, 2.0)}, ValueError, "sigma must be > 0"),
         ({"filter": ("gaussian", 0.5, 0.0)}, ValueError, "radius must be > 0"),
         ({"filter": ("gaussian", 0.5, 6.0)}, ValueError, "radius 6 is out of range"),
-        ({"transfer": Glow(1.0, shading=Phong())}, ValueError,
-         "splatting with sheet buffers does not shade .* mode='direct'"),
         ({"table": 3}, TypeError, "method 'splat' takes no option 'table'; its options: mode"),
     ],
 )

@@ -26,6 +26,13 @@ symmetric Gaussian's depends only on the ray's distance from the voxel; every ot
 read from a view-independent table over the ray's crossing of the voxel's slice plane and its
 slopes (:func:`vrlib.footprint.slanted`), or where clipped integrated along the ray exactly.
 
+Transfer functions that need gradients (shading, gradient opacity): the sheet modes splat each
+voxel's central-difference gradient (:func:`vrlib.gradients.gradient_volumes`) with the same
+footprints into three gradient sheets beside the value's, so a sheet holds the reconstructed
+gradient's integral as it holds the value's; each segment is classified by its mean value and
+mean gradient and shaded along the pixel's own ray. Direct mode classifies and shades each
+voxel by its own gradient before drawing it (:func:`classify_voxels`).
+
 Skips: voxels with zero value (and in direct mode zero density) are never drawn, the thesis's
 advantage on sparse data; in sheet modes neither are voxels whose neighbourhood the transfer
 function makes transparent (:func:`drawable`); with ``early_termination`` below 1, footprint
@@ -45,11 +52,10 @@ from vrlib import validate
 from vrlib._kernels import splat as _kernel
 from vrlib._kernels._jit import readonly
 from vrlib._scheduling import balanced_order
-from vrlib.arguments import refuse_gradients
 from vrlib.footprint import RADIAL, footprint, running_integral, slanted
-from vrlib.gradients import SLAB, gradient_volumes
+from vrlib.gradients import SLAB, gradient_volumes, kernel_lighting, no_gradients
 from vrlib.image import Image, RenderStats
-from vrlib.prefilter import Tally, prepared
+from vrlib.prefilter import Tally, prepared, prepared_gradients
 from vrlib.value_bounds import reconstructed_range, subset_bounds
 from vrlib.view import principal_axis
 
@@ -70,6 +76,31 @@ def _slice_order(array, axis):
     p and q the other axes in increasing order (a view, no copy)."""
     p_axis, q_axis = [a for a in range(3) if a != axis]
     return np.transpose(array, (2 - axis, 2 - p_axis, 2 - q_axis))
+
+
+def visible_neighbourhoods(volume, filt, transfer, mode):
+    """True for the voxels a sheet mode must draw: those whose neighbourhood can make a
+    point visible (:func:`drawable`'s test, the value aside).
+
+    Examples
+    --------
+    >>> from vrlib import Volume, LookupTransfer, make_filter
+    >>> data = np.full((9, 9, 9), 0.1); data[0, 0, 0] = 1.0
+    >>> step = LookupTransfer([0.0, 0.0, 0.0, 5.0, 5.0])    # transparent below 0.5
+    >>> int(visible_neighbourhoods(Volume(data), make_filter("trilinear"), step, "sheet").sum())
+    64
+    """
+    # Axis-aligned sheets average a slice's kernels over the stretch of the ray they cover,
+    # beyond the support's points: two voxels more keep that stretch transparent.
+    reach = 2 * math.ceil(filt.radius) - 1 + (2 if mode == "sheet" else 0)
+    pyr = volume.minmax_pyramid(CULL_BLOCK, margin=reach)
+    low, high = subset_bounds(pyr.minimum[0].astype(np.float64),
+                              pyr.maximum[0].astype(np.float64), filt)
+    visible = np.asarray(transfer.max_density(low, high)) > 0.0
+    # Sample i belongs to block min(i // 4, blocks - 1), whose samples include it.
+    index = [np.minimum(np.arange(n) // CULL_BLOCK, visible.shape[a] - 1)
+             for a, n in enumerate(volume.shape)]
+    return visible[np.ix_(*index)]
 
 
 def drawable(volume, filt, transfer, mode, *, cull=True):
@@ -102,17 +133,7 @@ def drawable(volume, filt, transfer, mode, *, cull=True):
     if mode != "direct":
         if not cull:
             return volume.data  # nonzero values are the ones to draw
-        # Axis-aligned sheets average a slice's kernels over the stretch of the ray they
-        # cover, beyond the support's points: two voxels more keep that stretch transparent.
-        reach = 2 * math.ceil(filt.radius) - 1 + (2 if mode == "sheet" else 0)
-        pyr = volume.minmax_pyramid(CULL_BLOCK, margin=reach)
-        low, high = subset_bounds(pyr.minimum[0].astype(np.float64),
-                                  pyr.maximum[0].astype(np.float64), filt)
-        visible = np.asarray(transfer.max_density(low, high)) > 0.0
-        # Sample i belongs to block min(i // 4, blocks - 1), whose samples include it.
-        index = [np.minimum(np.arange(n) // CULL_BLOCK, visible.shape[a] - 1)
-                 for a, n in enumerate(volume.shape)]
-        keep = visible[np.ix_(*index)]
+        keep = visible_neighbourhoods(volume, filt, transfer, mode)
         return np.where(keep, volume.data, 0.0) if not keep.all() else volume.data
     mask = np.empty(volume.shape, dtype=bool)
     for z in range(0, volume.shape[0], 16):
@@ -232,12 +253,9 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
         raise ValueError(f"direct splatting classifies each voxel before reconstruction, and "
                          f"the {filt.name!r} filter's voxels hold spline coefficients, not "
                          f"values to classify; use mode='sheet' (reconstruct, then classify)")
-    if mode != "direct":
-        refuse_gradients(transfer, "splatting with sheet buffers", "mode='direct' (each voxel "
-                         "classified and shaded), method='raycast' or vrlib.classify")
     start = time.perf_counter()
     tally = Tally()
-    volume = prepared(volume, filt, tally)  # prefiltered filters: splat the coefficients
+    samples, volume = volume, prepared(volume, filt, tally)  # prefiltered: the coefficients
     axis, ascending = principal_axis(view, volume)
     extent = volume.extent
     if view.is_perspective and extent[axis, 0] <= view.eye[axis] <= extent[axis, 1]:
@@ -282,9 +300,15 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
     lo, hi = reconstructed_range(volume, filt)
     span = max(hi - lo, abs(lo), abs(hi))
     vstart, vinv, density, emission = transfer.value_table(lo - 2 * span, hi + 2 * span)
-    per_voxel = transfer.needs_gradient  # direct mode: classified voxel by voxel
+    per_voxel = transfer.needs_gradient and mode == "direct"  # classified voxel by voxel
     voxel_density, voxel_colour = classify_voxels(volume, view, transfer) if per_voxel else (
         np.zeros((1, 1, 1), np.float32), np.zeros((1, 1, 1, 3), np.float32))
+    # Sheet modes with gradients: each voxel's gradient splatted beside its value.
+    lighting = transfer.needs_gradient and mode != "direct"
+    grads = prepared_gradients(samples, filt, tally, (0, 1, 2)) if lighting else (
+        no_gradients(np.float32))
+    lit = kernel_lighting(transfer, view.forward) if lighting else (
+        np.zeros(13), np.zeros(2), np.zeros(2))
     if per_voxel:
         marks = voxel_density
     elif mode == "direct":
@@ -293,7 +317,10 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
         marks = volume.cached(("splat-drawn", filt, transfer, empty_space_skipping),
                               lambda: drawable(volume, filt, transfer, mode,
                                                cull=empty_space_skipping), keep=2)
-    first, last = row_extents(volume, axis, marks) if (
+    # A voxel of value zero still carries a gradient: with gradients, the rows' extents
+    # are those of the voxels whose neighbourhood shows, whatever their values.
+    extents = visible_neighbourhoods(volume, filt, transfer, mode) if lighting else marks
+    first, last = row_extents(volume, axis, extents) if (
         empty_space_skipping) else full_extents(volume, axis)
     slices = np.arange(-ghost, volume.shape[2 - axis] + ghost)
     slices = slices if ascending else np.ascontiguousarray(slices[::-1])  # one array type
@@ -313,7 +340,8 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
         np.array(filt.code, dtype=np.float64), np.polynomial.legendre.leggauss(5),
         _KERNEL_MODES[mode], depth, slab,
         n_slabs, vstart, vinv, density,
-        emission, per_voxel, voxel_density, voxel_colour, early_termination,
+        emission, per_voxel, voxel_density, voxel_colour, grads, *lit,
+        early_termination,
         empty_space_skipping, first, last, near if view.is_perspective else -math.inf,
         reach_max, BAND,
         balanced_order(np.ones(bands), numba.get_num_threads()), out, voxels, pixels,

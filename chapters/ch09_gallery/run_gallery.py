@@ -36,11 +36,6 @@ def mri_transfer(volume):
     return vrlib.LookupTransfer(density / volume.bounding_radius, value_range=(lo, hi))
 
 
-#: Options a method needs to shade: sheet-buffer splatting reconstructs no gradients, so it
-#: splats each voxel classified and shaded.
-SHADED_OPTIONS = {"splat": {"mode": "direct"}}
-
-
 def colour_scenes():
     """``{name: (volume, filter, transfer, view options)}``: what a user draws from real data."""
     mni = data_gen.load("mni152")
@@ -75,8 +70,7 @@ def colour_gallery():
         images[f"{name}/reference"] = target
         errors[name] = {}
         for method in vrlib.METHODS:
-            img = vrlib.render(volume, view, method=method, filter=filt, transfer=transfer,
-                               **SHADED_OPTIONS.get(method, {}))
+            img = vrlib.render(volume, view, method=method, filter=filt, transfer=transfer)
             colour = img.composited()
             images[f"{name}/{method}"] = colour
             errors[name][method] = {

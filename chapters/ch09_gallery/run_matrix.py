@@ -7,8 +7,8 @@ average-intensity projection, shaded tissue labels with the box filter), orthogr
 perspective views: 70 cells. A volume of six Gaussian blobs, 48^3 into 96^2, trilinear (the
 box filter for the labels). A cell that renders gives the rmse of its premultiplied RGBA
 against the ray caster's image of the same cell (step 1/4 voxel); one that is refused keeps
-the message the user sees. Splatting's default sheet buffers refuse what its direct mode
-renders: such a cell is rendered again with ``mode="direct"`` and says so. Writes
+the message the user sees. A cell that splatting's default sheet buffers refuse but its
+direct mode renders is rendered again with ``mode="direct"`` and says so. Writes
 ``build/results/ch09_gallery/matrix.json``.
 """
 

@@ -47,7 +47,8 @@ from vrlib._kernels.footprint import (
     slanted_at,
     slanted_integral,
 )
-from vrlib._kernels.tables import interpolate, interpolate_channel
+from vrlib._kernels.shading import classify_by_gradient
+from vrlib._kernels.tables import interpolate, interpolate_channel, lookup, piecewise_linear
 
 SHEET, DIRECT, IMAGE = 0, 1, 2
 
@@ -113,12 +114,18 @@ def row_extents(marks, axis, first, last):
 
 
 @jit(inline="always")
-def _deposit(mode, f, fp, dens, er, eg, eb, threshold, sheet, touched, opaque, out, r, r0, c):
-    """One footprint pixel: into the sheet (``SHEET``, ``IMAGE``), or composited at once
+def _deposit(mode, f, fp, dens, er, eg, eb, threshold, sheet, touched, opaque, out, r, r0, c,
+             lighting, gsheet, g0, g1, g2):
+    """One footprint pixel: into the sheet (``SHEET``, ``IMAGE``; with ``lighting`` the
+    voxel's gradient ``g`` into the gradient sheets ``gsheet`` too), or composited at once
     (``DIRECT``)."""
     if mode != DIRECT:
         sheet[r - r0, c] += f * fp
         touched[r - r0, c] = True
+        if lighting:
+            gsheet[0, r - r0, c] += g0 * fp
+            gsheet[1, r - r0, c] += g1 * fp
+            gsheet[2, r - r0, c] += g2 * fp
         return
     alpha = -math.expm1(-dens * fp)
     remaining = 1.0 - out[r, c, 3]
@@ -139,6 +146,31 @@ def _composite(out, r, c, value, length, vstart, vinv, dens_tab, emit_tab):
     for ch in range(3):
         out[r, c, ch] += weight * interpolate_channel(emit_tab, vstart, vinv, value, ch)
     out[r, c, 3] += weight
+
+
+@jit
+def _composite_lit(out, r, c, value, gx, gy, gz, length, vstart, vinv, dens_tab, emit_tab, lit,
+                   ramp_x, ramp_y, dx, dy, dz):
+    """:func:`_composite` for a segment classified by its mean gradient ``g`` too (shading,
+    gradient opacity; ``lit``, ``ramp_x``, ``ramp_y`` from
+    :func:`vrlib.gradients.kernel_lighting`), seen along the unit ray direction ``d``."""
+    i, w = lookup((value - vstart) * vinv, dens_tab.shape[0])
+    dens = dens_tab[i] + w * (dens_tab[i + 1] - dens_tab[i])
+    if lit[2] != 0.0:  # gradient opacity scales the density
+        dens *= piecewise_linear(ramp_x, ramp_y, math.sqrt(gx * gx + gy * gy + gz * gz))
+    if not dens > 0.0:
+        return
+    # (a segment's length, and so its opacity, may be negative, as in _composite: a kernel's
+    # negative lobes)
+    lx, ly, lz = (-dx, -dy, -dz) if lit[1] != 0.0 else (lit[7], lit[8], lit[9])
+    alpha, cr, cg, cb = classify_by_gradient(
+        -math.expm1(-dens * length), i, w, emit_tab, gx, gy, gz, False, ramp_x, ramp_y,
+        lit[0] != 0.0, lx, ly, lz, dx, dy, dz, lit[3], lit[4], lit[5], lit[6])
+    remaining = 1.0 - out[r, c, 3]
+    out[r, c, 0] += remaining * cr
+    out[r, c, 1] += remaining * cg
+    out[r, c, 2] += remaining * cb
+    out[r, c, 3] += remaining * alpha
 
 
 @jit
@@ -254,7 +286,8 @@ def _slanted(table, reach, slope, kind, p0, p1, p2, radius, nodes, weights, cuts
 @jit
 def _flush(mode, s, r0, r1, width, axis, origin, spacing, radius, cumulative, z_lo, z_hi,
            slab_width, last_pass, sheet, touched, opaque, t_in, t_out, enter, leave, along,
-           cosines, held_length, last_length, out, threshold, vstart, vinv, dens_tab, emit_tab):
+           cosines, held_length, last_length, out, threshold, vstart, vinv, dens_tab, emit_tab,
+           lighting, gsheet, lit, ramp_x, ramp_y, camera, height):
     """Classify a band's sheet per pixel as one segment and composite it (eqs 1.4, 1.7), after
     a pass of :func:`splat`: the slice ``s`` (SHEET) or the slab ``[z_lo, z_hi]`` (IMAGE).
     Compiled apart from the parallel loop, which it would otherwise make slow to compile.
@@ -265,7 +298,9 @@ def _flush(mode, s, r0, r1, width, axis, origin, spacing, radius, cumulative, z_
     all slices, ghosts included, sum to the stretch); a share under a quarter of a slab's
     length (the slice near where the ray enters or leaves) is held for the next slice, and
     what is held at the end is composited after the last one (over its own share, which may
-    be negative for kernels with negative lobes).
+    be negative for kernels with negative lobes). With ``lighting`` the segment is
+    classified by its mean gradient too (the gradient sheets ``gsheet`` over its length),
+    seen along the pixel's ray (``camera``, an image ``height`` rows high).
     """
     for r in range(r0, r1):
         for c in range(width):
@@ -311,7 +346,18 @@ def _flush(mode, s, r0, r1, width, axis, origin, spacing, radius, cumulative, z_
             touched[r - r0, c] = False
             value = sheet[r - r0, c] / length
             sheet[r - r0, c] = 0.0
-            _composite(out, r, c, value, length, vstart, vinv, dens_tab, emit_tab)
+            if lighting:
+                gx = gsheet[0, r - r0, c] / length
+                gy = gsheet[1, r - r0, c] / length
+                gz = gsheet[2, r - r0, c] / length
+                gsheet[0, r - r0, c] = 0.0
+                gsheet[1, r - r0, c] = 0.0
+                gsheet[2, r - r0, c] = 0.0
+                d = pixel_ray(camera, height, width, r, c)[1]
+                _composite_lit(out, r, c, value, gx, gy, gz, length, vstart, vinv, dens_tab,
+                               emit_tab, lit, ramp_x, ramp_y, d[0], d[1], d[2])
+            else:
+                _composite(out, r, c, value, length, vstart, vinv, dens_tab, emit_tab)
             opaque[r - r0, c] = out[r, c, 3] >= threshold
 
 
@@ -320,8 +366,8 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
           cumulative, fkind, extent, extent_v, extent_s, sigma, radial, planar, partial,
           slanted, slanted_reach, slanted_slope, fcode, gauss, mode,
           slab_start, slab_width, n_slabs, vstart, vinv, dens_tab, emit_tab,
-          per_voxel, voxel_density, voxel_colour, threshold, cull, row_first, row_last,
-          near, reach_max, band, order, out, voxels, pixels):
+          per_voxel, voxel_density, voxel_colour, grads, lit, ramp_x, ramp_y, threshold, cull,
+          row_first, row_last, near, reach_max, band, order, out, voxels, pixels):
     """Splat ``data[z, y, x]`` into ``out`` (premultiplied RGBA), bands of ``band`` rows.
 
     ``axis`` (0, 1, 2 for x, y, z) is the slicing axis and ``slices`` its indices front to
@@ -340,9 +386,13 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
     walks ``n_slabs`` slabs of camera depth ``slab_width`` from ``slab_start``, each voxel
     adding the part of its line integral that lies in the slab.
     Classification reads density and emission tables over values (``vstart``, ``vinv``), or in
-    direct mode with ``per_voxel`` each voxel's own ``voxel_density`` and ``voxel_colour``. With
-    ``cull``, voxels of value zero are never drawn and in direct mode neither are voxels of
-    zero density. Pixels whose opacity has reached ``threshold`` take no more (1 turns that
+    direct mode with ``per_voxel`` each voxel's own ``voxel_density`` and ``voxel_colour``. In
+    the sheet modes, a transfer function that needs gradients (``lit``, ``ramp_x``,
+    ``ramp_y`` from :func:`vrlib.gradients.kernel_lighting`) has each voxel's gradient
+    ``grads[:, z, y, x]`` splatted into three gradient sheets beside the value's, and each
+    segment classified by its mean gradient too. With ``cull``, voxels of value zero are never
+    drawn (unless their gradients are splatted) and in direct mode neither are voxels of zero
+    density. Pixels whose opacity has reached ``threshold`` take no more (1 turns that
     off). ``row_first[s, p]`` and ``row_last[s, p]`` bound the voxels of each row of each
     slice that can be drawn. Voxels nearer than camera depth ``near`` are not drawn (ghosts
     beside an eye close to a face). ``reach_max`` bounds the footprint's reach in pixels over the
@@ -370,11 +420,13 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
     reach_depth = 2.0 * extent_s if perspective else extent_s
     widened = radius + 2.0 * slanted_reach / (slanted.shape[2] - 1)
     passes = n_slabs if mode == IMAGE else slices.shape[0]
+    lighting = mode != DIRECT and (lit[0] != 0.0 or lit[2] != 0.0)
     for it in prange(order.shape[0]):
         b = order[it]
         r0 = b * band
         r1 = min(r0 + band, height)
         sheet = np.zeros((r1 - r0, width))
+        gsheet = np.zeros((3, r1 - r0, width) if lighting else (3, 1, 1))
         touched = np.zeros((r1 - r0, width), dtype=np.bool_)
         opaque = np.zeros((r1 - r0, width), dtype=np.bool_)  # out[.., 3] >= threshold
         # Per pixel: the ray's stretch inside the box, where it enters and leaves along the
@@ -455,8 +507,13 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
                         kc = min(max(k, 0), nz - 1)
                         f = data[kc, jc, ic]
                         dens = 0.0
-                        if cull and f == 0.0:
+                        if cull and f == 0.0 and not lighting:
                             continue  # adds nothing to a sheet, and has no density to draw
+                        g0 = g1 = g2 = 0.0
+                        if lighting:
+                            g0 = grads[0, kc, jc, ic]
+                            g1 = grads[1, kc, jc, ic]
+                            g2 = grads[2, kc, jc, ic]
                         if mode == DIRECT:
                             if per_voxel:
                                 dens = voxel_density[kc, jc, ic]
@@ -544,7 +601,8 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
                                     if fp != 0.0:
                                         drawn += 1
                                         _deposit(mode, f, fp, dens, er, eg, eb, threshold,
-                                                 sheet, touched, opaque, out, r, r0, c)
+                                                 sheet, touched, opaque, out, r, r0, c,
+                                                 lighting, gsheet, g0, g1, g2)
                                 continue
                             # Orthographic, whole footprints: the row's offset v and its table
                             # row are shared.
@@ -557,7 +615,8 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
                                     if fp != 0.0 and not opaque[r - r0, c]:
                                         drawn += 1
                                         _deposit(mode, f, fp, dens, er, eg, eb, threshold,
-                                                 sheet, touched, opaque, out, r, r0, c)
+                                                 sheet, touched, opaque, out, r, r0, c,
+                                                 lighting, gsheet, g0, g1, g2)
                             else:
                                 row, ty = planar_row(extent_v, planar, v)
                                 if row < 0:
@@ -568,7 +627,8 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
                                     if fp != 0.0 and not opaque[r - r0, c]:
                                         drawn += 1
                                         _deposit(mode, f, fp, dens, er, eg, eb, threshold,
-                                                 sheet, touched, opaque, out, r, r0, c)
+                                                 sheet, touched, opaque, out, r, r0, c,
+                                                 lighting, gsheet, g0, g1, g2)
             if mode != DIRECT:
                 # (IMAGE passes are slabs, which may outnumber the slices: no slice to name)
                 sheet_slice = slices[pass_index] if mode == SHEET else 0
@@ -576,6 +636,7 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
                 _flush(mode, sheet_slice, r0, r1, width, axis, origin, spacing, radius,
                        cumulative, z_lo, z_hi, slab_width, last_pass, sheet, touched, opaque,
                        t_in, t_out, enter, leave, along, cosines, held_length, last_length,
-                       out, threshold, vstart, vinv, dens_tab, emit_tab)
+                       out, threshold, vstart, vinv, dens_tab, emit_tab, lighting, gsheet, lit,
+                       ramp_x, ramp_y, camera, height)
         voxels[b] = counted
         pixels[b] = drawn
