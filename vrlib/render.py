@@ -33,8 +33,8 @@ METHODS = {"raycast": render_raycast, "splat": render_splat, "shear3": render_sh
 #: Why a method has no maximum- or average-intensity projection (said with the refusal).
 _WHY_NOT_PROJECTED = {
     "splat": "a splat adds each voxel's footprint, integrated along the ray, into the image, "
-             "so what it holds per pixel is a sum over voxels, never the field's value at a "
-             "point of the ray, and its largest is not the field's maximum",
+             "so a pixel holds a sum over voxels, never the field's values at points of the "
+             "ray, whose largest or mean a projection takes",
     "shear3": "it would be shear-warp's projection after one or two more resampling passes, "
               "slower and less accurate",
     "shear2": "it would be shear-warp's projection after one more resampling pass, slower "
