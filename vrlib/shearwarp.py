@@ -227,8 +227,8 @@ def project_shearwarp(volume, view, *, filt, transfer, blend):
     >>> gray = vrlib.colormap("gray", [(0, 1), (1, 1)], clim=(0, 1))
     >>> view = vrlib.View.orbit(size=9)
     >>> img = vrlib.render(vol, view, method="shearwarp", transfer=gray, blend="maximum")
-    >>> round(float(img.rgba[4, 4, 0]), 2)  # near the peak
-    0.99
+    >>> bool(img.rgba[4, 4, 0] > 0.98)  # near the peak
+    True
     """
     start = time.perf_counter()
     axis, ascending = principal_axis(view, volume)
