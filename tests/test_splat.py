@@ -166,9 +166,12 @@ SHADED = LookupTransfer([0.0, 3.0, 1.0, 5.0], [[1, 0, 0], [0, 1, 0], [0, 0, 1], 
                         gradient_opacity=vrlib.GradientOpacity([0.0, 2.0], [0.2, 1.0]))
 
 
-@pytest.mark.parametrize("projection", ["orthographic", "perspective"])
-@pytest.mark.parametrize("filt, mode", [("trilinear", "sheet"), ("catmull-rom", "sheet"),
-                                        ("omoms", "sheet"), ("trilinear", "image-aligned")])
+@pytest.mark.parametrize("projection, filt, mode", [
+    (projection, filt, mode) if projection == "orthographic" or filt == "catmull-rom" else
+    pytest.param(projection, filt, mode, marks=pytest.mark.slow)  # make test-all
+    for projection in ("orthographic", "perspective")
+    for filt, mode in [("trilinear", "sheet"), ("catmull-rom", "sheet"), ("omoms", "sheet"),
+                       ("trilinear", "image-aligned")]])
 def test_shaded_sheets_match_naive_twin(projection, filt, mode):
     """Sheet buffers shade: each voxel's central-difference gradient is splatted beside its
     value, and each segment is classified by its mean gradient (gradient opacity) and shaded
@@ -184,7 +187,8 @@ def test_shaded_sheets_match_naive_twin(projection, filt, mode):
     assert np.abs(fast.rgba - plain).max() > 0.05  # the shading and the ramp show
 
 
-@pytest.mark.parametrize("projection", ["orthographic", "perspective"])
+@pytest.mark.parametrize("projection", ["orthographic",
+                                        pytest.param("perspective", marks=pytest.mark.slow)])
 def test_shaded_sheets_are_close_to_the_ray_casters(projection):
     """Against the ray caster at a quarter-voxel step: six blobs 48^3 -> 96^2, a shaded
     colour table and a gradient-opacity one, three views. Measured rmse of premultiplied
