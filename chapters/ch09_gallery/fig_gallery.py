@@ -1,6 +1,8 @@
 """Figures: the gallery grid (every method, with difference images), the colour scenes of the
 real volumes (every method, with colour differences) and the turntable GIF."""
 
+import textwrap
+
 import imageio.v3 as iio
 import matplotlib.pyplot as plt
 import numpy as np
@@ -44,7 +46,7 @@ def main():
     rows = []
     for scene in info["scenes"]:
         reference, errors = images[f"{scene}/reference"], info["errors"][scene]
-        rows.append((f"{scene}\n{errors['reference']}", reference[..., :3], [
+        rows.append((f"{textwrap.fill(scene, 24)}\n{errors['reference']}", reference[..., :3], [
             (f"{m}\nrmse {errors[m]['rmse']:.1e}", images[f"{scene}/{m}"][..., :3],
              images[f"{scene}/{m}"][..., 3] - reference[..., 3]) for m in METHODS]))
     method_grid(rows, figure_path(__file__, "gallery.png"), "opacity - reference")
@@ -52,7 +54,8 @@ def main():
     rows = []
     for scene in colour["scenes"]:
         reference, errors = images[f"{scene}/reference"], colour["errors"][scene]
-        rows.append((f"{scene}\nray casting, step 1/8", reference, [
+        # (the scene's name wrapped to its column: it would run into the next title)
+        rows.append((f"{textwrap.fill(scene, 24)}\nray casting, step 1/8", reference, [
             (f"{m}\nrmse {errors[m]['rmse']:.1e}", images[f"{scene}/{m}"],
              (images[f"{scene}/{m}"] - reference).mean(axis=-1)) for m in METHODS]))
     method_grid(rows, figure_path(__file__, "colour.png"), "colour - reference\n(mean of RGB)")
