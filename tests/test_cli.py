@@ -197,6 +197,7 @@ def test_bad_files_exit_2_with_one_line(tmp_path):
     assert not any(out.iterdir())
 
 
+@pytest.mark.slow  # three cold processes compile the shaded kernels; make test-all runs it
 def test_real_volumes_render_by_name_with_their_transfer_functions(tmp_path):
     """Each shipped volume in one command, with a colormap and opacity points or the
     automatic ramp, comes out as a picture (not empty, not a white silhouette)."""
