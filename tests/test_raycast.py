@@ -180,7 +180,7 @@ def test_exact_segment_ends_converge_at_second_order():
     assert errors["exact"][0] * 5 < errors["lattice"][0]
 
 
-@numba.njit(parallel=True)
+@numba.njit(parallel=True, cache=True)
 def _take_all(counter, taken, threads):
     for _ in numba.prange(threads):
         while True:

@@ -25,14 +25,11 @@ def main():
     calls += [("classified", "trilinear", lit), ("classified", "trilinear", None)]
     calls += [(m, f, t) for m in ("splat", "raycast") for f, t in
               [("omoms", None), ("catmull-rom", lit)]]
-    calls += [("projection", "shearwarp", None), ("projection", "raycast", None)]
     for dtype in (np.float64, np.float32):
         volume = field.sample(9, dtype=dtype)
         for method, filt, transfer in calls:
             try:
-                if method == "projection":
-                    vrlib.render(volume, view, method=filt, blend="maximum")
-                elif method == "classified":
+                if method == "classified":
                     vrlib.classify(volume, transfer).render(view)
                 elif method == "splat-perspective":  # the slanted footprints' tables
                     vrlib.render(volume, vrlib.View.orbit(size=8, projection="perspective"),
