@@ -138,13 +138,16 @@ def twin_cases():
     """(projection, filter, mode) for the twins. Image-aligned twins are slow (every voxel in
     every slab, pixel by pixel): `make test` takes three filters (the tent, a cubic with
     negative lobes, the radial Gaussian) orthographic and the cubic in perspective,
-    `make test-all` every one."""
+    `make test-all` every one. Perspective sheets and direct splats take the same three
+    filters in `make test` (the slanted table of planar footprints, and the radial one's
+    closed form), every filter in `make test-all`."""
     for projection in ("orthographic", "perspective"):
         for f in FILTERS:
-            yield projection, f, "sheet"
-            yield projection, f, "direct"
-            fast = f in ("trilinear", "catmull-rom", "gaussian") if (
-                projection == "orthographic") else f == "catmull-rom"
+            three = f in ("trilinear", "catmull-rom", "gaussian")
+            for mode in ("sheet", "direct"):
+                yield pytest.param(projection, f, mode, marks=() if (
+                    projection == "orthographic" or three) else pytest.mark.slow)
+            fast = three if projection == "orthographic" else f == "catmull-rom"
             yield pytest.param(projection, f, "image-aligned",
                                marks=() if fast else pytest.mark.slow)
 
