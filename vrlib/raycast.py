@@ -293,15 +293,13 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
     out = np.zeros(view.shape + (4,))
     rows, cols = -(-view.height // TILE[0]), -(-view.width // TILE[1])
     samples = np.zeros(rows * cols, dtype=np.int64)
-    # Cost of a tile: the pixels whose rays can meet something visible (plus a little for the
-    # rest), so that threads share the work evenly. Tiles without such a pixel stay
-    # transparent and are not handed out at all.
-    mask = skip[3]
+    # Cost of a tile: the pixels whose rays can meet something visible; the threads take the
+    # heaviest tiles first. Tiles without such a pixel stay transparent and are not handed
+    # out at all.
     padded = np.zeros((rows * TILE[0], cols * TILE[1]))
-    padded[: view.height, : view.width] = mask
-    seen = padded.reshape(rows, TILE[0], cols, TILE[1]).sum(axis=(1, 3)).ravel()
-    live = np.flatnonzero(seen)
-    costs = seen[live] + 0.05 * TILE[0] * TILE[1]
+    padded[: view.height, : view.width] = skip[3]
+    costs = padded.reshape(rows, TILE[0], cols, TILE[1]).sum(axis=(1, 3)).ravel()
+    live = np.flatnonzero(costs)
     # One array type per argument (read-only samples, contiguous vectors): every other
     # combination would compile the kernel once more.
     vector = np.ascontiguousarray
@@ -311,8 +309,8 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
               *lattice_extent(global_shape, spacing, origin).T.copy())
     skips = (early_termination, *skip, np.zeros((1, 1, 1)) if bound is None else bound,
              float(budget))
-    tiles = (*TILE, live[np.argsort(-costs, kind="stable")], numba.get_num_threads(), out,
-             samples)  # the heaviest tiles first
+    tiles = (*TILE, live[np.argsort(-costs[live], kind="stable")], numba.get_num_threads(),
+             out, samples)
     if preintegrated:
         profile = "step" if filt.radius <= 0.5 else "linear"  # the box filter jumps
         _kernel.raycast_preintegrated(

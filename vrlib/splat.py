@@ -317,9 +317,13 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
         marks = volume.cached(("splat-drawn", filt, transfer, empty_space_skipping),
                               lambda: drawable(volume, filt, transfer, mode,
                                                cull=empty_space_skipping), keep=2)
-    # A voxel of value zero still carries a gradient: with gradients, the rows' extents
-    # are those of the voxels whose neighbourhood shows, whatever their values.
-    extents = visible_neighbourhoods(volume, filt, transfer, mode) if lighting else marks
+    extents = marks
+    if lighting and empty_space_skipping:
+        # A voxel of value zero still carries a gradient: the rows' extents are those of the
+        # voxels whose neighbourhood shows, whatever their values (kept with the volume).
+        extents = volume.cached(("splat-visible", filt, transfer, mode),
+                                lambda: visible_neighbourhoods(volume, filt, transfer, mode),
+                                keep=2)
     first, last = row_extents(volume, axis, extents) if (
         empty_space_skipping) else full_extents(volume, axis)
     slices = np.arange(-ghost, volume.shape[2 - axis] + ghost)

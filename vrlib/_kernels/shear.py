@@ -475,17 +475,19 @@ def project_slices(slices, order, scale, di, dj, fkind, fp0, fp1, fp2, radius, n
             j = s * row + dj[k]
             if j < 0.0 or j > n_j - 1:
                 continue
-            j_first = int(math.floor(j - radius)) + 1
+            j_first = filter_taps(fkind, fp0, fp1, fp2, radius, ntaps, j, wj)
             for b in range(ntaps):
-                wj[b] = weight(fkind, fp0, fp1, fp2, j - (j_first + b))
                 rows[b] = clamp(j_first + b, n_j)
             big_first = max(0, int(math.ceil(-di[k] / s)))
             big_last = min(width - 1, int(math.floor((n_i - 1.0 - di[k]) / s)))
+            # Orthographic: one fractional offset per slice, one set of weights for it all.
+            shared = s == 1.0
+            tap0 = filter_taps(fkind, fp0, fp1, fp2, radius, ntaps, di[k], wi) if shared else 0
             for big_i in range(big_first, big_last + 1):
-                i = s * big_i + di[k]
-                i0 = int(math.floor(i - radius)) + 1
-                for a in range(ntaps):
-                    wi[a] = weight(fkind, fp0, fp1, fp2, i - (i0 + a))
+                if shared:
+                    i0 = big_i + tap0
+                else:
+                    i0 = filter_taps(fkind, fp0, fp1, fp2, radius, ntaps, s * big_i + di[k], wi)
                 v = _slice_sum(slices, k, rows, i0, ntaps, wi, wj)
                 if not maximum:
                     value[row, big_i] += v
