@@ -278,7 +278,7 @@ def test_version():
 
 def test_compiling_is_said_once(capsys):
     """The command line says once, when numba first compiles, that it does (a cold cache's
-    wait is 5 to 20 s); later compiles in the same run say nothing."""
+    wait is 3 to 12 s); later compiles in the same run say nothing."""
     import numba
 
     from vrlib import cli

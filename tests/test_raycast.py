@@ -11,7 +11,9 @@ from naive import exact_blob_image, image_mass, random_orbits, raycast_naive
 import data_gen
 import vrlib
 from vrlib import Glow, LookupTransfer, Phong, View, Volume, metrics, render, render_reference
+from vrlib._kernels._jit import borrowed
 from vrlib._kernels.queue import take
+from vrlib._scheduling import on_threads
 from vrlib.parallel.sources import ghost as ghost_samples
 from vrlib.raycast import cast_rays
 from vrlib.value_bounds import reconstructed_range
@@ -185,24 +187,54 @@ def test_exact_segment_ends_converge_at_second_order():
     assert errors["exact"][0] * 5 < errors["lattice"][0]
 
 
-@numba.njit(parallel=True, cache=True)
-def _take_all(counter, taken, threads):
-    for _ in numba.prange(threads):
-        while True:
-            item = take(counter)
-            if item >= taken.shape[0]:
-                break
-            taken[item] += 1
+@numba.njit(cache=True, nogil=True)
+def _take_all(counter, taken):
+    while True:
+        item = take(counter)
+        if item >= taken.shape[0]:
+            break
+        taken[item] += 1
 
 
 def test_the_tile_queue_hands_out_every_item_once():
-    """The threads share the ray caster's tiles through one counter: each item is taken by
-    exactly one thread (an increment that is not atomic would hand some out twice)."""
+    """The threads share the ray caster's tiles through one counter, each running the
+    compiled worker at once without the GIL (``on_threads``, as the renderers do): each
+    item is taken by exactly one thread (an increment that is not atomic would hand some
+    out twice)."""
+    threads = numba.get_num_threads()
     taken = np.zeros(2_000_000, dtype=np.int64)
     counter = np.zeros(1, dtype=np.int64)
-    _take_all(counter, taken, numba.get_num_threads())
+    on_threads(lambda i: _take_all(counter, taken), threads)
     assert (taken == 1).all()
-    assert counter[0] == taken.size + numba.get_num_threads()
+    calls = 1 if numba.config.DISABLE_JIT else threads  # without the JIT: one call takes all
+    assert counter[0] == taken.size + calls
+
+
+def test_on_threads_raises_what_a_call_raises():
+    if numba.config.DISABLE_JIT:
+        pytest.skip("without the JIT one call takes every item")
+    calls = []
+
+    def work(i):
+        calls.append(i)
+        if i == 1:
+            raise ValueError("call 1 failed")
+
+    with pytest.raises(ValueError, match="call 1 failed"):
+        on_threads(work, 2)
+    assert sorted(calls) == [0, 1]
+
+
+@numba.njit(cache=True)
+def _borrowed_sum(values):
+    view = borrowed(values)
+    return view.sum(), view.shape[0]
+
+
+def test_a_borrowed_view_reads_the_same_array():
+    """``borrowed`` drops only the reference count: the same data, shape and values."""
+    values = np.arange(10.0)
+    assert _borrowed_sum(values) == (45.0, 10)
 
 
 @pytest.mark.parametrize("options", [{}, {"segment_ends": "exact"},

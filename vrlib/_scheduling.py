@@ -1,16 +1,16 @@
-"""How parallel loops share out their work: each thread of a numba ``prange`` takes one
-contiguous run of the iteration space, so the order of the items decides the balance; and how
-many threads they run on."""
+"""How many threads the kernels run on (:func:`thread_count`), and running a compiled
+worker that takes its items from a shared queue on that many threads (:func:`on_threads`)."""
 
 from __future__ import annotations
 
+import concurrent.futures
 import contextlib
 import numbers
+import threading
 
 import numba
-import numpy as np
 
-__all__ = ["balanced_order", "thread_count"]
+__all__ = ["on_threads", "thread_count"]
 
 
 @contextlib.contextmanager
@@ -38,21 +38,46 @@ def thread_count(threads):
         numba.set_num_threads(previous)
 
 
-def balanced_order(costs, parts):
-    """Tile order for a parallel loop that hands each of ``parts`` threads an equal run of it.
+_pool = None
+_pool_lock = threading.Lock()
 
-    Tiles are sorted by estimated cost and dealt to ``parts`` runs in snake order (heaviest
-    first, 0, 1, ..., p-1, p-1, ..., 0), so the runs carry nearly equal work and each holds
-    tiles from all over the image.
+
+def on_threads(work, threads):
+    """Call ``work(i)`` for ``i`` in ``range(threads)`` on as many threads at once (the
+    caller's among them: ``i = 0``) and return when every call has; an exception in any is
+    raised here. ``i`` lets each call keep scratch of its own.
+
+    ``work`` is a compiled kernel that releases the GIL (``nogil``) and takes its items from
+    a shared queue (:func:`vrlib._kernels.queue.take`) until none is left, so the calls
+    share the items out between them. Python threads run it instead of a numba ``prange``:
+    the kernel compiles as a plain serial function, without numba's parallel passes (half
+    the ray caster's first compile). Without the JIT (``NUMBA_DISABLE_JIT``) the queue is a
+    plain counter, not atomic, and one call takes every item.
 
     Examples
     --------
-    >>> balanced_order(np.array([5.0, 1.0, 1.0, 5.0]), 2).tolist()
-    [0, 2, 3, 1]
+    >>> import numpy as np
+    >>> from vrlib._kernels.queue import take
+    >>> counter, seen = np.zeros(1, np.int64), []
+    >>> def work(i):
+    ...     while (item := take(counter)) < 5:
+    ...         seen.append(item)
+    >>> on_threads(work, 1)
+    >>> seen
+    [0, 1, 2, 3, 4]
     """
-    order = np.argsort(-np.asarray(costs, dtype=np.float64), kind="stable")
-    runs = [[] for _ in range(parts)]
-    for rank, tile in enumerate(order):
-        cycle, position = divmod(rank, parts)
-        runs[position if cycle % 2 == 0 else parts - 1 - position].append(tile)
-    return np.concatenate([np.asarray(run, dtype=np.int64) for run in runs])
+    global _pool
+    if threads <= 1 or numba.config.DISABLE_JIT:
+        work(0)
+        return
+    with _pool_lock:
+        if _pool is None:
+            _pool = concurrent.futures.ThreadPoolExecutor(
+                max(1, numba.config.NUMBA_NUM_THREADS - 1), thread_name_prefix="vrlib")
+        others = [_pool.submit(work, i) for i in range(1, threads)]
+    try:
+        work(0)
+    finally:
+        concurrent.futures.wait(others)
+    for call in others:
+        call.result()

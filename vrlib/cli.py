@@ -726,7 +726,7 @@ def _as_flags(text):
 
 
 #: What the command line says when numba compiles (:func:`_say_when_compiling`).
-_COMPILING = ("compiling the renderer's kernels for this machine, once (5 to 20 s; later "
+_COMPILING = ("compiling the renderer's kernels for this machine, once (3 to 12 s; later "
               "runs load them from the cache)")
 
 

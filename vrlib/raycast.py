@@ -18,7 +18,8 @@ import numpy as np
 from vrlib import validate
 from vrlib._kernels import raycast as _kernel
 from vrlib._kernels._jit import readonly
-from vrlib._kernels.filters import TENT
+from vrlib._kernels.filters import MAX_TAPS, TENT
+from vrlib._scheduling import on_threads
 from vrlib.adaptive import step_multipliers
 from vrlib.image import Image, RenderStats
 from vrlib.prefilter import Tally, prepared
@@ -29,7 +30,7 @@ from vrlib.volume import lattice_extent
 __all__ = ["render_raycast", "cast_rays", "segment_options", "operations_per_sample",
            "skip_bounds", "brightest"]
 
-#: Pixels (rows, columns) of the image tiles that the parallel loop hands out.
+#: Pixels (rows, columns) of the image tiles that the threads take from the queue.
 TILE = (32, 32)
 
 
@@ -309,24 +310,29 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
               *lattice_extent(global_shape, spacing, origin).T.copy())
     skips = (early_termination, *skip, np.zeros((1, 1, 1)) if bound is None else bound,
              float(budget))
-    tiles = (*TILE, live[np.argsort(-costs[live], kind="stable")], numba.get_num_threads(),
+    # The tiles, heaviest first, behind a queue that every thread takes the next one from;
+    # each thread's own scratch for the filter's weights.
+    tiles = (*TILE, live[np.argsort(-costs[live], kind="stable")], np.zeros(1, np.int64),
              out, samples)
+    threads = numba.get_num_threads()
+    scratch = np.zeros((threads, 6, MAX_TAPS))
     if preintegrated:
         profile = "step" if filt.radius <= 0.5 else "linear"  # the box filter jumps
-        _kernel.raycast_preintegrated(
-            *layout, view.packed(), view.height, view.width, ds, *filt.code, filt.radius,
-            filt.taps, *transfer.preintegrated_table(ds, *value_range, profile=profile),
-            *lighting, *by_gradient, *skips, *tiles)
+        arguments = (*layout, view.packed(), view.height, view.width, ds, *filt.code,
+                     filt.radius, filt.taps,
+                     *transfer.preintegrated_table(ds, *value_range, profile=profile),
+                     *lighting, *by_gradient, *skips, *tiles)
+        on_threads(lambda i: _kernel.raycast_preintegrated(*arguments, scratch[i]), threads)
     else:
         grey = shading is None and bool(np.all(tables[4] == 1.0))  # colour equals opacity
         # The kernel compiled for this kind of render (the tent filter unshaded, a volume
         # with nothing to skip: a smaller kernel, a shorter first wait).
         general = None if filt.code[0] == TENT and shading is None and ramp is None else True
         skipping = None if skip[2] == 0 else True
-        _kernel.raycast(
-            *layout, bool(exact_ends), view.packed(), view.height, view.width, ds,
-            *filt.code, filt.radius, filt.taps, *tables, *lighting, *by_gradient, *skips,
-            np.ones((1, 1, 1), np.int64) if multiplier is None else multiplier, *tiles, grey,
-            general, skipping)
+        arguments = (*layout, bool(exact_ends), view.packed(), view.height, view.width, ds,
+                     *filt.code, filt.radius, filt.taps, *tables, *lighting, *by_gradient,
+                     *skips, np.ones((1, 1, 1), np.int64) if multiplier is None else multiplier,
+                     *tiles, grey, general, skipping)
+        on_threads(lambda i: _kernel.raycast(*arguments, scratch[i]), threads)
     np.clip(out[..., 3], 0.0, 1.0, out=out[..., 3])
     return out, int(samples.sum())

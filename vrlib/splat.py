@@ -51,7 +51,7 @@ import numpy as np
 from vrlib import validate
 from vrlib._kernels import splat as _kernel
 from vrlib._kernels._jit import readonly
-from vrlib._scheduling import balanced_order
+from vrlib._scheduling import on_threads
 from vrlib.footprint import RADIAL, footprint, running_integral, slanted
 from vrlib.gradients import SLAB, gradient_volumes, kernel_lighting, no_gradients
 from vrlib.image import Image, RenderStats
@@ -333,7 +333,7 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
     voxels = np.zeros(bands, np.int64)
     pixels = np.zeros(bands, np.int64)
     dummy1, dummy2, dummy3 = np.zeros(2), np.zeros((2, 2)), np.zeros((2, 2, 2))
-    _kernel.splat(
+    arguments = (
         readonly(volume.data if mode == "direct" else marks), volume.origin, spacing,
         view.packed(), view.height, view.width, axis, slices, ghost, float(filt.radius),
         running_integral(filt), fp.kind, fp.extent, fp.extent_v or fp.extent, fp.extent_s,
@@ -348,8 +348,18 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
         early_termination,
         empty_space_skipping, first, last, near if view.is_perspective else -math.inf,
         reach_max, BAND,
-        balanced_order(np.ones(bands), numba.get_num_threads()), out, voxels, pixels,
+        np.arange(bands), np.zeros(1, np.int64), out, voxels, pixels,
     )
+    # Each thread's own scratch: a band's sheets and per-pixel records, the cuts of the
+    # exact footprints.
+    threads = numba.get_num_threads()
+    planes = np.zeros((threads, 9, BAND, view.width))
+    gplanes = np.zeros((threads, 3, BAND, view.width) if lighting else
+                       (threads, 3, 1, 1))
+    flags = np.zeros((threads, 2, BAND, view.width), dtype=bool)
+    cuts = np.zeros((threads, 12 * math.ceil(filt.radius) + 5))
+    on_threads(lambda i: _kernel.splat(*arguments, planes[i], gplanes[i], flags[i], cuts[i]),
+               threads)
     drawn = int(pixels.sum())
     stats = RenderStats(
         samples=drawn,

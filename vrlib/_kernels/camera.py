@@ -28,13 +28,13 @@ PIXEL, RADIUS, DISTANCE = 12, 13, 14
 SIZE = 15
 
 
-@jit
+@jit(inline="always")
 def is_perspective(camera):
     """True for a perspective camera (an eye at a finite distance)."""
     return camera[DISTANCE] != 0.0
 
 
-@jit
+@jit(inline="always")
 def start(camera):
     """Where rays start: the centre of the origin plane, ``RADIUS`` before the scene centre
     (orthographic), or the eye (perspective); as :attr:`vrlib.View.start`."""

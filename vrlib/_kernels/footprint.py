@@ -53,6 +53,19 @@ def planar_at(extent, planar, j, ty, u):
             + ty * ((1.0 - tx) * planar[j + 1, i] + tx * planar[j + 1, i + 1]))
 
 
+@jit
+def sort_prefix(values, count):
+    """Sort ``values[:count]`` in place, ascending: insertion sort, for the few dozen cuts of
+    a line integral (numba's own sort costs two seconds of a first render's compile)."""
+    for n in range(1, count):
+        item = values[n]
+        m = n - 1
+        while m >= 0 and values[m] > item:
+            values[m + 1] = values[m]
+            m -= 1
+        values[m + 1] = item
+
+
 @parallel_jit
 def partial_table(kind, p0, p1, p2, radius, spacing, basis, extent_u, extent_v, extent_s,
                   nodes, weights, table):
@@ -86,7 +99,7 @@ def partial_table(kind, p0, p1, p2, radius, spacing, basis, extent_u, extent_v, 
                     if -extent_s < t < extent_s:
                         cuts[count] = t
                         count += 1
-            cuts[:count].sort()
+            sort_prefix(cuts, count)
             total = 0.0
             table[j, i, 0] = 0.0
             c = 0
@@ -205,7 +218,7 @@ def slanted_integral(kind, p0, p1, p2, radius, bp, bq, mp, mq, nodes, weights, s
                 if lo < t < hi:
                     cuts[count] = t
                     count += 1
-    cuts[:count].sort()
+    sort_prefix(cuts, count)
     total = 0.0
     for c in range(count - 1):
         half = 0.5 * (cuts[c + 1] - cuts[c])

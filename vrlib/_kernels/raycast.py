@@ -23,10 +23,9 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-from numba import literally, prange
+from numba import literally
 
-from vrlib._kernels._jit import jit, parallel_jit
+from vrlib._kernels._jit import borrowed, jit
 from vrlib._kernels.camera import pixel_ray, ray_box
 from vrlib._kernels.filters import CUBIC, TENT
 from vrlib._kernels.preintegration import bilinear_channel, psi_at
@@ -35,7 +34,6 @@ from vrlib._kernels.sampling import (
     gradient,
     reconstruct,
     separable4,
-    tap_scratch,
     tricubic,
     trilinear,
 )
@@ -204,7 +202,7 @@ def _preintegrated_ray(tent, data, flat, offset, gshape, inv, d, ax, ay, az, bx,
                        radius, ntaps, start, vinv, density, psi, emission, step, grey,
                        col_start, col_inv, mean, shade, ka, kd, ks, shininess, light,
                        headlight, ramp_x, ramp_y, by_gradient, threshold, empty, clearance, block,
-                       fine_counts, bound, budget):
+                       fine_counts, bound, budget, wx, wy, wz, dx, dy, dz):
     """One ray, pre-integrated: each segment ``[k ds, (k + 1) ds)`` (cut at the volume's
     faces) classified from its values at its two ends (the back of one is the front of the
     next), front to back from segment ``k`` while its middle lies before ``t_out``. Returns
@@ -212,9 +210,9 @@ def _preintegrated_ray(tent, data, flat, offset, gshape, inv, d, ax, ay, az, bx,
     for the tent filter, with no call in it, and once for the others, which call
     :func:`_other_value`; a call in the loop, even one not taken, made the tent filter's
     loop three times slower) says the filter is the tent; the other arguments are
-    :func:`raycast`'s (the table's named without ``pre_``)."""
+    :func:`raycast`'s (the table's named without ``pre_``), and ``wx ... dz`` scratch for
+    the filter's weights (:func:`~vrlib._kernels.sampling.tap_scratch`)."""
     literally(tent)
-    wx, wy, wz, dx, dy, dz = tap_scratch()
     nx = data.shape[2]
     nxy = data.shape[1] * data.shape[2]
     oz, oy, ox = offset[0], offset[1], offset[2]
@@ -385,14 +383,14 @@ def _pixel_start(r, c, camera, height, width, mask, box_lo, box_hi, vol_lo, vol_
     return hit, d, t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, t_first, t_last
 
 
-@parallel_jit
+@jit
 def raycast_preintegrated(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo,
                           vol_hi, camera, height, width, ds, fkind, fp0, fp1, fp2, radius,
                           ntaps, pre_start, pre_inv, pre_density, pre_psi, pre_emission,
                           pre_step, pre_grey, col_start, col_inv, pre_mean, shade, ka, kd, ks,
                           shininess, light, headlight, ramp_x, ramp_y, by_gradient, threshold,
                           empty, clearance, block, mask, bound, budget, tile_h, tile_w, order,
-                          threads, out, samples):
+                          counter, out, samples, scratch):
     """:func:`raycast` with pre-integrated classification (a kernel of its own, so that a
     render compiles only the loop it runs): each segment is classified from its values at
     its two ends (:func:`_preintegrated_ray`), always cut at the volume's faces. The
@@ -403,80 +401,69 @@ def raycast_preintegrated(data, offset, gshape, origin, spacing, box_lo, box_hi,
     each end's value, ``pre_emission`` on the density's grid
     (:class:`vrlib.transfer.PreintegratedTable`). The other arguments are as for
     :func:`raycast`."""
-    flat = data.reshape(-1)
-    inv = 1.0 / spacing
-    fine_counts = np.array(empty.shape)
-    counter = np.zeros(1, np.int64)
-    for _ in prange(threads):
-        while True:
-            it = take(counter)
-            if it >= order.shape[0]:
-                break
-            tile_id = order[it]
-            samples[tile_id] = _tile_preintegrated(
-                tile_id, data, flat, inv, fine_counts, offset, gshape, origin,
-                box_lo, box_hi, vol_lo, vol_hi, camera, height, width, ds, fkind, fp0, fp1, fp2,
-                radius, ntaps, pre_start, pre_inv, pre_density, pre_psi, pre_emission, pre_step,
-                pre_grey, col_start, col_inv, pre_mean, shade, ka, kd, ks, shininess, light,
-                headlight, ramp_x, ramp_y, by_gradient, threshold, empty, clearance, block, mask,
-                bound, budget, tile_h, tile_w, out)
+    # Views without reference counts for the call per ray (the caller keeps the arrays).
+    data, offset, gshape, origin = borrowed(data), borrowed(offset), borrowed(gshape), \
+        borrowed(origin)
+    camera, light = borrowed(camera), borrowed(light)
+    pre_density, pre_psi = borrowed(pre_density), borrowed(pre_psi)
+    pre_emission, pre_mean = borrowed(pre_emission), borrowed(pre_mean)
+    ramp_x, ramp_y = borrowed(ramp_x), borrowed(ramp_y)
+    empty, clearance, bound = borrowed(empty), borrowed(clearance), borrowed(bound)
+    wx, wy, wz = borrowed(scratch[0]), borrowed(scratch[1]), borrowed(scratch[2])
+    dx, dy, dz = borrowed(scratch[3]), borrowed(scratch[4]), borrowed(scratch[5])
+    flat = borrowed(data.reshape(-1))
+    inv = (1.0 / spacing[0], 1.0 / spacing[1], 1.0 / spacing[2])
+    fine_counts = empty.shape
+    tiles_across = (width + tile_w - 1) // tile_w
+    while True:
+        it = take(counter)
+        if it >= order.shape[0]:
+            break
+        tile_id = order[it]
+        row0 = (tile_id // tiles_across) * tile_h
+        col0 = (tile_id % tiles_across) * tile_w
+        taken = 0
+        for p in range(tile_h * tile_w):
+            r = row0 + p // tile_w
+            c = col0 + p % tile_w
+            hit, d, t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, t_first, t_last = \
+                _pixel_start(r, c, camera, height, width, mask, box_lo, box_hi, vol_lo,
+                             vol_hi, True, origin, inv, ds)
+            if not hit:
+                continue
+            # One compiled loop per reconstruction: the tent filter's holds no call.
+            if fkind == TENT:
+                rgba = _preintegrated_ray(
+                    True, data, flat, offset, gshape, inv, d, ax, ay, az, bx, by, bz, t_in, t_out,
+                    k, ds, k_first, k_last, t_first, t_last, fkind, fp0, fp1, fp2, radius, ntaps,
+                    pre_start, pre_inv, pre_density, pre_psi, pre_emission, pre_step, pre_grey,
+                    col_start, col_inv, pre_mean, shade, ka, kd, ks, shininess, light, headlight,
+                    ramp_x, ramp_y, by_gradient, threshold, empty, clearance, block, fine_counts,
+                    bound, budget, wx, wy, wz, dx, dy, dz)
+            else:
+                rgba = _preintegrated_ray(
+                    False, data, flat, offset, gshape, inv, d, ax, ay, az, bx, by, bz, t_in, t_out,
+                    k, ds, k_first, k_last, t_first, t_last, fkind, fp0, fp1, fp2, radius, ntaps,
+                    pre_start, pre_inv, pre_density, pre_psi, pre_emission, pre_step, pre_grey,
+                    col_start, col_inv, pre_mean, shade, ka, kd, ks, shininess, light, headlight,
+                    ramp_x, ramp_y, by_gradient, threshold, empty, clearance, block, fine_counts,
+                    bound, budget, wx, wy, wz, dx, dy, dz)
+            out[r, c, 0] = rgba[0]
+            out[r, c, 1] = rgba[1]
+            out[r, c, 2] = rgba[2]
+            out[r, c, 3] = rgba[3]
+            taken += rgba[4]
+        samples[tile_id] = taken
 
 
 @jit
-def _tile_preintegrated(tile_id, data, flat, inv, fine_counts, offset, gshape,
-                        origin, box_lo, box_hi, vol_lo, vol_hi, camera, height, width, ds,
-                        fkind, fp0, fp1, fp2, radius, ntaps, pre_start, pre_inv, pre_density,
-                        pre_psi, pre_emission, pre_step, pre_grey, col_start, col_inv,
-                        pre_mean, shade, ka, kd, ks, shininess, light, headlight, ramp_x,
-                        ramp_y, by_gradient, threshold, empty, clearance, block, mask, bound,
-                        budget, tile_h, tile_w, out):
-    """Tile ``tile_id`` of :func:`raycast_preintegrated` (the same arguments, as
-    :func:`_tile`'s): its pixels' rays, front to back; returns the samples taken."""
-    tiles_across = (width + tile_w - 1) // tile_w
-    row0 = (tile_id // tiles_across) * tile_h
-    col0 = (tile_id % tiles_across) * tile_w
-    taken = 0
-    for p in range(tile_h * tile_w):
-        r = row0 + p // tile_w
-        c = col0 + p % tile_w
-        hit, d, t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, t_first, t_last = \
-            _pixel_start(r, c, camera, height, width, mask, box_lo, box_hi, vol_lo,
-                         vol_hi, True, origin, inv, ds)
-        if not hit:
-            continue
-        # One compiled loop per reconstruction: the tent filter's holds no call.
-        if fkind == TENT:
-            rgba = _preintegrated_ray(
-                True, data, flat, offset, gshape, inv, d, ax, ay, az, bx, by, bz, t_in, t_out,
-                k, ds, k_first, k_last, t_first, t_last, fkind, fp0, fp1, fp2, radius, ntaps,
-                pre_start, pre_inv, pre_density, pre_psi, pre_emission, pre_step, pre_grey,
-                col_start, col_inv, pre_mean, shade, ka, kd, ks, shininess, light, headlight,
-                ramp_x, ramp_y, by_gradient, threshold, empty, clearance, block, fine_counts,
-                bound, budget)
-        else:
-            rgba = _preintegrated_ray(
-                False, data, flat, offset, gshape, inv, d, ax, ay, az, bx, by, bz, t_in, t_out,
-                k, ds, k_first, k_last, t_first, t_last, fkind, fp0, fp1, fp2, radius, ntaps,
-                pre_start, pre_inv, pre_density, pre_psi, pre_emission, pre_step, pre_grey,
-                col_start, col_inv, pre_mean, shade, ka, kd, ks, shininess, light, headlight,
-                ramp_x, ramp_y, by_gradient, threshold, empty, clearance, block, fine_counts,
-                bound, budget)
-        out[r, c, 0] = rgba[0]
-        out[r, c, 1] = rgba[1]
-        out[r, c, 2] = rgba[2]
-        out[r, c, 3] = rgba[3]
-        taken += rgba[4]
-    return taken
-
-
-@parallel_jit
 def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_hi, exact,
             camera, height, width, ds,
             fkind, fp0, fp1, fp2, radius, ntaps,
             tstart, tinv, alpha_tab, color_tab, emit_tab,
             shade, ka, kd, ks, shininess, light, headlight, ramp_x, ramp_y, by_gradient,
             threshold, empty, clearance, block, mask, bound, budget, multiplier, tile_h, tile_w,
-            order, threads, out, samples, grey, general, skipping):
+            order, counter, out, samples, grey, general, skipping, scratch):
     """Render ``out[row, col] = (r, g, b, a)`` premultiplied (``out`` comes transparent: a
     pixel whose ray meets nothing, and a tile left out of ``order``, stay so); count samples
     per tile.
@@ -486,12 +473,13 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
     ``origin``; the rays of the packed view ``camera`` (one per pixel of a ``height x width``
     image) sample the world box ``[box_lo, box_hi]`` of a volume whose own box is
     ``[vol_lo, vol_hi]`` (cut exactly at its faces when ``exact``). The image is cut into
-    ``tile_h x tile_w`` pixel tiles; each of ``threads`` threads takes the next tile of
-    ``order`` (the heaviest first) from a shared queue (:func:`vrlib._kernels.queue.take`)
-    until none is left, so that the threads finish together however unevenly the tiles
-    cost; neighbouring rays read neighbouring voxels, so a tile keeps them in cache. Each
-    pixel is computed independently and in a fixed order: the image depends neither on the
-    number of threads nor on which thread took which tile.
+    ``tile_h x tile_w`` pixel tiles; a call takes the next tile of ``order`` (the heaviest
+    first) from the shared queue ``counter`` (:func:`vrlib._kernels.queue.take`) until none
+    is left. Several threads make the call at once (:func:`vrlib._scheduling.on_threads`;
+    the kernel releases the GIL) and finish together however unevenly the tiles cost;
+    neighbouring rays read neighbouring voxels, so a tile keeps them in cache. Each pixel is
+    computed independently and in a fixed order: the image depends neither on the number of
+    threads nor on which thread took which tile.
 
     Skips: ``empty`` flags blocks of ``block`` cells per axis that nothing visible can come
     from, and ``clearance`` (per block, an integer array of the same shape) the Chebyshev
@@ -512,39 +500,22 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
     table's colour, without shading or gradient opacity, and ``skipping`` None leaves out
     the skipping (``block = 0``). numba drops a branch on a None argument before it types
     the function, so such a kernel compiles in about half the time (a first render's wait);
-    ``True`` compiles every path.
+    ``True`` compiles every path. ``scratch`` (6 x ``MAX_TAPS``, this call's own) holds
+    the filter's weights and their derivatives along x, y and z.
     """
-    # The loop runs one compiled tile function per task: numba's parallel passes then see this
-    # short loop only, not the tracing code (a third of the compile time otherwise).
-    flat = data.reshape(-1)
-    inv = 1.0 / spacing
-    fine_counts = np.array(empty.shape)
-    counter = np.zeros(1, np.int64)
-    for _ in prange(threads):
-        while True:
-            it = take(counter)
-            if it >= order.shape[0]:
-                break
-            tile_id = order[it]
-            samples[tile_id] = _tile(
-                tile_id, data, flat, inv, fine_counts, offset, gshape, origin,
-                box_lo, box_hi, vol_lo, vol_hi, exact, camera, height, width,
-                ds, fkind, fp0, fp1, fp2, radius, ntaps, tstart, tinv, alpha_tab, color_tab,
-                emit_tab, shade, ka, kd, ks, shininess, light, headlight, ramp_x, ramp_y,
-                by_gradient, threshold, empty, clearance, block, mask, bound, budget, multiplier,
-                tile_h, tile_w, out, grey, general, skipping)
-
-
-@jit
-def _tile(tile_id, data, flat, inv, fine_counts, offset, gshape, origin,
-          box_lo, box_hi, vol_lo, vol_hi, exact, camera, height, width, ds, fkind, fp0, fp1, fp2,
-          radius, ntaps, tstart, tinv, alpha_tab, color_tab, emit_tab, shade, ka, kd, ks,
-          shininess, light, headlight, ramp_x, ramp_y, by_gradient, threshold, empty, clearance,
-          block, mask, bound, budget, multiplier, tile_h, tile_w, out, grey, general,
-          skipping):
-    """Tile ``tile_id`` of :func:`raycast` (the same arguments): its pixels' rays, front to
-    back, in a fixed order; returns the samples taken. ``flat`` is ``data`` raveled, ``inv``
-    the inverse spacing, ``fine_counts`` the skip grid's shape."""
+    # Views without reference counts for the calls per pixel and per sample (the caller
+    # keeps the arrays).
+    data, offset, gshape, origin = borrowed(data), borrowed(offset), borrowed(gshape), \
+        borrowed(origin)
+    camera, emit_tab, light = borrowed(camera), borrowed(emit_tab), borrowed(light)
+    ramp_x, ramp_y = borrowed(ramp_x), borrowed(ramp_y)
+    empty, clearance, bound, multiplier = borrowed(empty), borrowed(clearance), \
+        borrowed(bound), borrowed(multiplier)
+    wx, wy, wz = borrowed(scratch[0]), borrowed(scratch[1]), borrowed(scratch[2])
+    dx, dy, dz = borrowed(scratch[3]), borrowed(scratch[4]), borrowed(scratch[5])
+    flat = borrowed(data.reshape(-1))
+    inv = (1.0 / spacing[0], 1.0 / spacing[1], 1.0 / spacing[2])
+    fine_counts = empty.shape
     tiles_across = (width + tile_w - 1) // tile_w
     nx = data.shape[2]
     nxy = data.shape[1] * data.shape[2]
@@ -552,157 +523,160 @@ def _tile(tile_id, data, flat, inv, fine_counts, offset, gshape, origin,
     gz, gy, gx = gshape[0], gshape[1], gshape[2]
     ntab = alpha_tab.shape[0]
     adaptive = block > 0 and multiplier.shape == empty.shape
-    row0 = (tile_id // tiles_across) * tile_h
-    col0 = (tile_id % tiles_across) * tile_w
-    wx, wy, wz, dx, dy, dz = tap_scratch()
-    taken = 0
-    for p in range(tile_h * tile_w):
-        r = row0 + p // tile_w
-        c = col0 + p % tile_w
-        hit, d, t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, t_first, t_last = \
-            _pixel_start(r, c, camera, height, width, mask, box_lo, box_hi, vol_lo,
-                         vol_hi, exact, origin, inv, ds)
-        if not hit:
-            continue
-        acc_r = 0.0
-        acc_g = 0.0
-        acc_b = 0.0
-        acc_a = 0.0
-        spent = 0.0  # the budget's share this ray has used
-        if general is None and skipping is None and grey:
-            # The common case, its loop stripped: tent filter, white unshaded emission,
-            # nothing to skip. The same arithmetic as the general loop below.
-            while True:
-                t = (k + 0.5) * ds
-                fraction = 1.0
-                if k == k_first or k == k_last:
-                    t, fraction = _cut_segment(k, ds, t_first, t_last)
-                    if t < t_in:  # another brick's sample
-                        k += 1
-                        continue
-                if t >= t_out:
-                    break
-                value = trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ax + t * bx,
-                                  ay + t * by, az + t * bz)
-                taken += 1
-                k += 1
-                i, w = lookup((value - tstart) * tinv, ntab)
-                alpha = alpha_tab[i] + w * (alpha_tab[i + 1] - alpha_tab[i])
-                if not alpha > 0.0:
-                    continue
-                if fraction != 1.0:
-                    alpha = _part_of_segment(alpha, fraction)
-                remaining = 1.0 - acc_a
-                acc_r += remaining * alpha
-                acc_a += remaining * alpha
-                if acc_a >= threshold:
-                    break
-            acc_g = acc_r
-            acc_b = acc_r
-        else:
-            # Samples before t_check lie in a block already found not empty: no check needed
-            # (a sample that rounding puts in an empty block anyway adds exactly nothing).
-            t_check = -math.inf if block > 0 else math.inf
-            m_block = 1  # the step multiplier of the block before t_check, entered at t_enter
-            t_enter = 0.0
-            while True:
-                t = (k + 0.5) * ds
-                fraction = 1.0
-                if k == k_first or k == k_last:
-                    t, fraction = _cut_segment(k, ds, t_first, t_last)
-                    if t < t_in:  # another brick's sample
-                        k += 1
-                        continue
-                if t >= t_out:
-                    break
-                ux = ax + t * bx
-                uy = ay + t * by
-                uz = az + t * bz
-                if skipping is not None and t >= t_check:
-                    k_next, t_check, spent = _skip(
-                        k, ux, uy, uz, ax, ay, az, bx, by, bz, ds, False, empty, clearance,
-                        block, fine_counts, bound, budget, spent, k_first,
-                        k_last, t_first, t_last, adaptive)
-                    if k_next > k:
-                        k = k_next
-                        continue
-                    if adaptive:
-                        m_block = _block_bound(multiplier, block, ux, uy, uz)
-                        t_enter = _entry(ax, ay, az, bx, by, bz, block, fine_counts, ux, uy,
-                                         uz)
-                if skipping is not None and m_block > 1:
-                    # Adaptive steps: one sample, at its middle, for an aligned run of m
-                    # segments inside this block (vrlib.adaptive bounds the change).
-                    k0, m = _long_segment(k, m_block, ds, t_enter, t_check, k_first, k_last)
-                    if m > 1:
-                        k = k0 + m - 1  # the last of the run: k + 1 follows it
-                        t = (k0 + 0.5 * m) * ds
+    while True:
+        it = take(counter)
+        if it >= order.shape[0]:
+            break
+        tile_id = order[it]
+        row0 = (tile_id // tiles_across) * tile_h
+        col0 = (tile_id % tiles_across) * tile_w
+        taken = 0
+        for p in range(tile_h * tile_w):
+            r = row0 + p // tile_w
+            c = col0 + p % tile_w
+            hit, d, t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, t_first, t_last = \
+                _pixel_start(r, c, camera, height, width, mask, box_lo, box_hi, vol_lo,
+                             vol_hi, exact, origin, inv, ds)
+            if not hit:
+                continue
+            acc_r = 0.0
+            acc_g = 0.0
+            acc_b = 0.0
+            acc_a = 0.0
+            spent = 0.0  # the budget's share this ray has used
+            if general is None and skipping is None and grey:
+                # The common case, its loop stripped: tent filter, white unshaded emission,
+                # nothing to skip. The same arithmetic as the general loop below.
+                while True:
+                    t = (k + 0.5) * ds
+                    fraction = 1.0
+                    if k == k_first or k == k_last:
+                        t, fraction = _cut_segment(k, ds, t_first, t_last)
                         if t < t_in:  # another brick's sample
                             k += 1
                             continue
-                        if t >= t_out:
-                            break
-                        ux = ax + t * bx
-                        uy = ay + t * by
-                        uz = az + t * bz
-                        fraction = float(m)
-                # The two common filters unrolled, the others through the general loop.
-                if general is None or fkind == TENT:
-                    value = trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz)
-                elif fkind == CUBIC:
-                    value = tricubic(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz,
-                                     fp0, fp1, fp2)
-                elif ntaps == 4:
-                    value = separable4(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz,
-                                       fkind, fp0, fp1, fp2, radius)
-                else:
-                    value = reconstruct(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1,
-                                        fp2, radius, ntaps, wx, wy, wz)
-                taken += 1
-                k += 1
-                # Classify: segment opacity 1 - exp(-density ds) (eq 1.4) and colour
-                # E alpha (eq 1.9), from the table.
-                i, w = lookup((value - tstart) * tinv, ntab)
-                alpha = alpha_tab[i] + w * (alpha_tab[i + 1] - alpha_tab[i])
-                if not alpha > 0.0:
-                    continue  # a transparent segment adds exactly nothing
-                if grey and not by_gradient:
-                    cr = cg = cb = alpha  # white emission, no shading: colour = opacity
-                elif general is not None and (shade or by_gradient):
-                    gx_, gy_, gz_ = gradient(data, offset, gshape, ux, uy, uz, fkind, fp0,
-                                             fp1, fp2, radius, ntaps, wx, wy, wz, dx, dy,
-                                             dz)
-                    if headlight:
-                        lx, ly, lz = -d[0], -d[1], -d[2]
-                    else:
-                        lx, ly, lz = light[0], light[1], light[2]
-                    alpha, cr, cg, cb = classify_by_gradient(
-                        alpha, i, w, emit_tab, gx_ * inv[0], gy_ * inv[1], gz_ * inv[2],
-                        by_gradient, ramp_x, ramp_y, shade, lx, ly, lz, d[0], d[1], d[2],
-                        ka, kd, ks, shininess)
+                    if t >= t_out:
+                        break
+                    value = trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ax + t * bx,
+                                      ay + t * by, az + t * bz)
+                    taken += 1
+                    k += 1
+                    i, w = lookup((value - tstart) * tinv, ntab)
+                    alpha = alpha_tab[i] + w * (alpha_tab[i + 1] - alpha_tab[i])
                     if not alpha > 0.0:
                         continue
-                else:
-                    cr = color_tab[i, 0] + w * (color_tab[i + 1, 0] - color_tab[i, 0])
-                    cg = color_tab[i, 1] + w * (color_tab[i + 1, 1] - color_tab[i, 1])
-                    cb = color_tab[i, 2] + w * (color_tab[i + 1, 2] - color_tab[i, 2])
-                if fraction != 1.0:  # a segment cut by the volume's face, or a long one
-                    part = _part_of_segment(alpha, fraction)
-                    cr *= part / alpha
-                    cg *= part / alpha
-                    cb *= part / alpha
-                    alpha = part
-                # Front-to-back over, eqs 1.7-1.8.
-                remaining = 1.0 - acc_a
-                acc_r += remaining * cr
-                acc_g += remaining * cg
-                acc_b += remaining * cb
-                acc_a += remaining * alpha
-                if acc_a >= threshold:
-                    break
-        out[r, c, 0] = acc_r
-        out[r, c, 1] = acc_g
-        out[r, c, 2] = acc_b
-        out[r, c, 3] = acc_a
-    return taken
-
+                    if fraction != 1.0:
+                        alpha = _part_of_segment(alpha, fraction)
+                    remaining = 1.0 - acc_a
+                    acc_r += remaining * alpha
+                    acc_a += remaining * alpha
+                    if acc_a >= threshold:
+                        break
+                acc_g = acc_r
+                acc_b = acc_r
+            else:
+                # Samples before t_check lie in a block already found not empty: no check needed
+                # (a sample that rounding puts in an empty block anyway adds exactly nothing).
+                t_check = -math.inf if block > 0 else math.inf
+                m_block = 1  # the step multiplier of the block before t_check, entered at t_enter
+                t_enter = 0.0
+                while True:
+                    t = (k + 0.5) * ds
+                    fraction = 1.0
+                    if k == k_first or k == k_last:
+                        t, fraction = _cut_segment(k, ds, t_first, t_last)
+                        if t < t_in:  # another brick's sample
+                            k += 1
+                            continue
+                    if t >= t_out:
+                        break
+                    ux = ax + t * bx
+                    uy = ay + t * by
+                    uz = az + t * bz
+                    if skipping is not None and t >= t_check:
+                        k_next, t_check, spent = _skip(
+                            k, ux, uy, uz, ax, ay, az, bx, by, bz, ds, False, empty, clearance,
+                            block, fine_counts, bound, budget, spent, k_first,
+                            k_last, t_first, t_last, adaptive)
+                        if k_next > k:
+                            k = k_next
+                            continue
+                        if adaptive:
+                            m_block = _block_bound(multiplier, block, ux, uy, uz)
+                            t_enter = _entry(ax, ay, az, bx, by, bz, block, fine_counts, ux, uy,
+                                             uz)
+                    if skipping is not None and m_block > 1:
+                        # Adaptive steps: one sample, at its middle, for an aligned run of m
+                        # segments inside this block (vrlib.adaptive bounds the change).
+                        k0, m = _long_segment(k, m_block, ds, t_enter, t_check, k_first, k_last)
+                        if m > 1:
+                            k = k0 + m - 1  # the last of the run: k + 1 follows it
+                            t = (k0 + 0.5 * m) * ds
+                            if t < t_in:  # another brick's sample
+                                k += 1
+                                continue
+                            if t >= t_out:
+                                break
+                            ux = ax + t * bx
+                            uy = ay + t * by
+                            uz = az + t * bz
+                            fraction = float(m)
+                    # The two common filters unrolled, the others through the general loop.
+                    if general is None or fkind == TENT:
+                        value = trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz)
+                    elif fkind == CUBIC:
+                        value = tricubic(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz,
+                                         fp0, fp1, fp2)
+                    elif ntaps == 4:
+                        value = separable4(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz,
+                                           fkind, fp0, fp1, fp2, radius)
+                    else:
+                        value = reconstruct(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1,
+                                            fp2, radius, ntaps, wx, wy, wz)
+                    taken += 1
+                    k += 1
+                    # Classify: segment opacity 1 - exp(-density ds) (eq 1.4) and colour
+                    # E alpha (eq 1.9), from the table.
+                    i, w = lookup((value - tstart) * tinv, ntab)
+                    alpha = alpha_tab[i] + w * (alpha_tab[i + 1] - alpha_tab[i])
+                    if not alpha > 0.0:
+                        continue  # a transparent segment adds exactly nothing
+                    if grey and not by_gradient:
+                        cr = cg = cb = alpha  # white emission, no shading: colour = opacity
+                    elif general is not None and (shade or by_gradient):
+                        gx_, gy_, gz_ = gradient(data, offset, gshape, ux, uy, uz, fkind, fp0,
+                                                 fp1, fp2, radius, ntaps, wx, wy, wz, dx, dy,
+                                                 dz)
+                        if headlight:
+                            lx, ly, lz = -d[0], -d[1], -d[2]
+                        else:
+                            lx, ly, lz = light[0], light[1], light[2]
+                        alpha, cr, cg, cb = classify_by_gradient(
+                            alpha, i, w, emit_tab, gx_ * inv[0], gy_ * inv[1], gz_ * inv[2],
+                            by_gradient, ramp_x, ramp_y, shade, lx, ly, lz, d[0], d[1], d[2],
+                            ka, kd, ks, shininess)
+                        if not alpha > 0.0:
+                            continue
+                    else:
+                        cr = color_tab[i, 0] + w * (color_tab[i + 1, 0] - color_tab[i, 0])
+                        cg = color_tab[i, 1] + w * (color_tab[i + 1, 1] - color_tab[i, 1])
+                        cb = color_tab[i, 2] + w * (color_tab[i + 1, 2] - color_tab[i, 2])
+                    if fraction != 1.0:  # a segment cut by the volume's face, or a long one
+                        part = _part_of_segment(alpha, fraction)
+                        cr *= part / alpha
+                        cg *= part / alpha
+                        cb *= part / alpha
+                        alpha = part
+                    # Front-to-back over, eqs 1.7-1.8.
+                    remaining = 1.0 - acc_a
+                    acc_r += remaining * cr
+                    acc_g += remaining * cg
+                    acc_b += remaining * cb
+                    acc_a += remaining * alpha
+                    if acc_a >= threshold:
+                        break
+            out[r, c, 0] = acc_r
+            out[r, c, 1] = acc_g
+            out[r, c, 2] = acc_b
+            out[r, c, 3] = acc_a
+        samples[tile_id] = taken

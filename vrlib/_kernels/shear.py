@@ -527,9 +527,11 @@ def _warp_pixel(inter, x, y, out, row, c, grey):
 def _columns_within(a, b, lo, hi, width):
     """The columns ``c`` of ``[0, width)`` with ``lo <= a c + b <= hi``, widened by one
     column each way (rounding): ``(first, stop)``, empty when ``first >= stop``."""
+    if a == 0.0:  # parallel to the box's sides
+        return (0, width) if not lo > b and not b > hi else (0, 0)
     c0 = (lo - b) / a
     c1 = (hi - b) / a
-    if a == 0.0 or not (c0 == c0 and c1 == c1):  # parallel to the box's sides, or NaN
+    if not (c0 == c0 and c1 == c1):  # NaN
         return (0, width) if not lo > b and not b > hi else (0, 0)
     if c0 > c1:
         c0, c1 = c1, c0

@@ -26,7 +26,7 @@ import math
 import numpy as np
 from numba import prange
 
-from vrlib._kernels._jit import jit, parallel_jit
+from vrlib._kernels._jit import borrowed, jit, parallel_jit
 from vrlib._kernels.camera import (
     FORWARD,
     PIXEL,
@@ -47,6 +47,7 @@ from vrlib._kernels.footprint import (
     slanted_at,
     slanted_integral,
 )
+from vrlib._kernels.queue import take
 from vrlib._kernels.shading import classify_by_gradient
 from vrlib._kernels.tables import interpolate, interpolate_channel, lookup, piecewise_linear
 
@@ -290,7 +291,7 @@ def _flush(mode, s, r0, r1, width, axis, origin, spacing, radius, cumulative, z_
            lighting, gsheet, lit, ramp_x, ramp_y, camera, height):
     """Classify a band's sheet per pixel as one segment and composite it (eqs 1.4, 1.7), after
     a pass of :func:`splat`: the slice ``s`` (SHEET) or the slab ``[z_lo, z_hi]`` (IMAGE).
-    Compiled apart from the parallel loop, which it would otherwise make slow to compile.
+    Compiled apart from :func:`splat`, which it would otherwise make slow to compile.
 
     IMAGE: the segment is the slab's stretch of the ray inside the box (a stretch under a
     quarter of the slab, where the ray enters, is held for the next slab). SHEET: the slice's
@@ -361,14 +362,22 @@ def _flush(mode, s, r0, r1, width, axis, origin, spacing, radius, cumulative, z_
             opaque[r - r0, c] = out[r, c, 3] >= threshold
 
 
-@parallel_jit
+@jit
 def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, radius,
           cumulative, fkind, extent, extent_v, extent_s, sigma, radial, planar, partial,
           slanted, slanted_reach, slanted_slope, fcode, gauss, mode,
           slab_start, slab_width, n_slabs, vstart, vinv, dens_tab, emit_tab,
           per_voxel, voxel_density, voxel_colour, grads, lit, ramp_x, ramp_y, threshold, cull,
-          row_first, row_last, near, reach_max, band, order, out, voxels, pixels):
-    """Splat ``data[z, y, x]`` into ``out`` (premultiplied RGBA), bands of ``band`` rows.
+          row_first, row_last, near, reach_max, band, order, counter, out, voxels, pixels,
+          planes, gplanes, flags, cuts):
+    """Splat ``data[z, y, x]`` into ``out`` (premultiplied RGBA), bands of ``band`` rows: a
+    call takes the next band of ``order`` from the shared queue ``counter``
+    (:func:`vrlib._kernels.queue.take`) until none is left, and several threads make the
+    call at once (:func:`vrlib._scheduling.on_threads`); each band is composited in a fixed
+    order, whichever thread takes it. ``planes`` (9 x ``band`` x ``width``), ``gplanes``
+    (3 x ``band`` x ``width``), ``flags`` (2 x ``band`` x ``width``, bool) and ``cuts``
+    (``12 ceil(radius) + 5``) are the call's own scratch: a band's sheets and per-pixel
+    records, and the exact footprints' cuts.
 
     ``axis`` (0, 1, 2 for x, y, z) is the slicing axis and ``slices`` its indices front to
     back, ``ghost`` slices beyond each face included: the lattice is extended by repeating its
@@ -399,6 +408,28 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
     volume. ``voxels`` and ``pixels`` count, per band, the footprints drawn and the footprint
     pixels drawn.
     """
+    # Views without reference counts for the calls per voxel and per pixel (the caller
+    # keeps the arrays).
+    data, origin, spacing, camera = borrowed(data), borrowed(origin), borrowed(spacing), \
+        borrowed(camera)
+    cumulative, radial, planar, partial = borrowed(cumulative), borrowed(radial), \
+        borrowed(planar), borrowed(partial)
+    slanted, fcode, dens_tab, emit_tab = borrowed(slanted), borrowed(fcode), \
+        borrowed(dens_tab), borrowed(emit_tab)
+    voxel_density, voxel_colour, grads = borrowed(voxel_density), borrowed(voxel_colour), \
+        borrowed(grads)
+    lit, ramp_x, ramp_y, out = borrowed(lit), borrowed(ramp_x), borrowed(ramp_y), borrowed(out)
+    nodes, weights = borrowed(gauss[0]), borrowed(gauss[1])
+    planes, gplanes, flags, cuts = borrowed(planes), borrowed(gplanes), borrowed(flags), \
+        borrowed(cuts)
+    # A band's sheet and gradient sheets; per pixel, whether the sheet holds anything,
+    # whether the pixel is opaque (out[.., 3] >= threshold), the ray's stretch inside the
+    # box, where it enters and leaves along the slicing axis, its direction's component along
+    # that axis and its cosine with the view's axis; the share of the stretch held in the
+    # sheet, and the length the last composited sheet stood for.
+    sheet, gsheet, touched, opaque = planes[0], gplanes, flags[0], flags[1]
+    t_in, t_out, enter, leave = planes[1], planes[2], planes[3], planes[4]
+    along, cosines, held_length, last_length = planes[5], planes[6], planes[7], planes[8]
     nz, ny, nx = data.shape
     counts = (nx, ny, nz)
     pa = 1 if axis == 0 else 0
@@ -421,27 +452,19 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
     widened = radius + 2.0 * slanted_reach / (slanted.shape[2] - 1)
     passes = n_slabs if mode == IMAGE else slices.shape[0]
     lighting = mode != DIRECT and (lit[0] != 0.0 or lit[2] != 0.0)
-    for it in prange(order.shape[0]):
+    while True:
+        it = take(counter)
+        if it >= order.shape[0]:
+            break
         b = order[it]
         r0 = b * band
         r1 = min(r0 + band, height)
-        sheet = np.zeros((r1 - r0, width))
-        gsheet = np.zeros((3, r1 - r0, width) if lighting else (3, 1, 1))
-        touched = np.zeros((r1 - r0, width), dtype=np.bool_)
-        opaque = np.zeros((r1 - r0, width), dtype=np.bool_)  # out[.., 3] >= threshold
-        # Per pixel: the ray's stretch inside the box, where it enters and leaves along the
-        # slicing axis, its direction's component along that axis and its cosine with the
-        # view's axis; the share of the stretch held in the sheet, and the length the last
-        # composited sheet stood for.
-        t_in = np.empty((r1 - r0, width))
-        t_out = np.empty((r1 - r0, width))
-        enter = np.empty((r1 - r0, width))
-        leave = np.empty((r1 - r0, width))
-        along = np.empty((r1 - r0, width))
-        cosines = np.empty((r1 - r0, width))
-        held_length = np.zeros((r1 - r0, width))
-        last_length = np.zeros((r1 - r0, width))
-        cuts = np.empty(12 * int(math.ceil(radius)) + 5)  # scratch of the exact footprints
+        sheet[:] = 0.0
+        if lighting:
+            gsheet[:] = 0.0
+        touched[:] = False
+        held_length[:] = 0.0
+        last_length[:] = 0.0
         for r in range(r0, r1):
             for c in range(width):
                 opaque[r - r0, c] = out[r, c, 3] >= threshold
@@ -579,8 +602,8 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
                                         if fkind != RADIAL:
                                             fp = _slanted(slanted, slanted_reach, slanted_slope,
                                                           fcode[0], fcode[1], fcode[2],
-                                                          fcode[3], radius, gauss[0],
-                                                          gauss[1], cuts, o, d, x, y, z,
+                                                          fcode[3], radius, nodes,
+                                                          weights, cuts, o, d, x, y, z,
                                                           spacing, axis, pa, qa, lo, hi)
                                         else:
                                             # Ray point minus voxel, across the ray: its
