@@ -325,14 +325,16 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
         on_threads(lambda i: _kernel.raycast_preintegrated(*arguments, scratch[i]), threads)
     else:
         grey = shading is None and bool(np.all(tables[4] == 1.0))  # colour equals opacity
-        # The kernel compiled for this kind of render (the tent filter unshaded, a volume
-        # with nothing to skip: a smaller kernel, a shorter first wait).
-        general = None if filt.code[0] == TENT and shading is None and ramp is None else True
+        # The kernel compiled for this kind of render (the tent filter, no shading or
+        # gradient opacity, a volume with nothing to skip: a smaller kernel, a shorter first
+        # wait).
+        filtering = None if filt.code[0] == TENT else True
+        lit = None if shading is None and ramp is None else True
         skipping = None if skip[2] == 0 else True
         arguments = (*layout, bool(exact_ends), view.packed(), view.height, view.width, ds,
                      *filt.code, filt.radius, filt.taps, *tables, *lighting, *by_gradient,
                      *skips, np.ones((1, 1, 1), np.int64) if multiplier is None else multiplier,
-                     *tiles, grey, general, skipping)
+                     *tiles, grey, filtering, lit, skipping)
         on_threads(lambda i: _kernel.raycast(*arguments, scratch[i]), threads)
     np.clip(out[..., 3], 0.0, 1.0, out=out[..., 3])
     return out, int(samples.sum())

@@ -463,7 +463,7 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
             tstart, tinv, alpha_tab, color_tab, emit_tab,
             shade, ka, kd, ks, shininess, light, headlight, ramp_x, ramp_y, by_gradient,
             threshold, empty, clearance, block, mask, bound, budget, multiplier, tile_h, tile_w,
-            order, counter, out, samples, grey, general, skipping, scratch):
+            order, counter, out, samples, grey, filtering, lighting, skipping, scratch):
     """Render ``out[row, col] = (r, g, b, a)`` premultiplied (``out`` comes transparent: a
     pixel whose ray meets nothing, and a tile left out of ``order``, stay so); count samples
     per tile.
@@ -496,11 +496,11 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
     ``by_gradient`` multiplies the density by the piecewise-linear factor through
     ``(ramp_x, ramp_y)`` of the gradient magnitude (per world unit).
 
-    Compiled per kind of render: ``general`` None compiles only the tent filter and a
-    table's colour, without shading or gradient opacity, and ``skipping`` None leaves out
-    the skipping (``block = 0``). numba drops a branch on a None argument before it types
-    the function, so such a kernel compiles in about half the time (a first render's wait);
-    ``True`` compiles every path. ``scratch`` (6 x ``MAX_TAPS``, this call's own) holds
+    Compiled per kind of render: ``filtering`` None compiles only the tent filter,
+    ``lighting`` None only a table's colour (no shading, no gradient opacity), and
+    ``skipping`` None leaves out the skipping (``block = 0``). numba drops a branch on a
+    None argument before it types the function, so such a kernel compiles in a fraction of
+    the time (a first render's wait); ``True`` compiles that path. ``scratch`` (6 x ``MAX_TAPS``, this call's own) holds
     the filter's weights and their derivatives along x, y and z.
     """
     # Views without reference counts for the calls per pixel and per sample (the caller
@@ -544,7 +544,7 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
             acc_b = 0.0
             acc_a = 0.0
             spent = 0.0  # the budget's share this ray has used
-            if general is None and skipping is None and grey:
+            if filtering is None and lighting is None and skipping is None and grey:
                 # The common case, its loop stripped: tent filter, white unshaded emission,
                 # nothing to skip. The same arithmetic as the general loop below.
                 while True:
@@ -622,7 +622,7 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                             uz = az + t * bz
                             fraction = float(m)
                     # The two common filters unrolled, the others through the general loop.
-                    if general is None or fkind == TENT:
+                    if filtering is None or fkind == TENT:
                         value = trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz)
                     elif fkind == CUBIC:
                         value = tricubic(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz,
@@ -643,7 +643,7 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                         continue  # a transparent segment adds exactly nothing
                     if grey and not by_gradient:
                         cr = cg = cb = alpha  # white emission, no shading: colour = opacity
-                    elif general is not None and (shade or by_gradient):
+                    elif lighting is not None and (shade or by_gradient):
                         gx_, gy_, gz_ = gradient(data, offset, gshape, ux, uy, uz, fkind, fp0,
                                                  fp1, fp2, radius, ntaps, wx, wy, wz, dx, dy,
                                                  dz)
