@@ -28,7 +28,7 @@ import numpy as np
 from vrlib import validate
 from vrlib._kernels.classified import composite_classified, shade_table
 from vrlib._kernels.shear import warp
-from vrlib._scheduling import on_threads, thread_count
+from vrlib._scheduling import thread_count
 from vrlib.arguments import check_transfer, framed_view
 from vrlib.colormapping import default_transfer
 from vrlib.filters import make_filter
@@ -285,11 +285,10 @@ class ClassifiedVolume:
             factor, highlight = self._shade_tables(view, shading)
             inter = np.zeros((height, width, 4))
             counts = np.zeros(height, np.int64)
-            arguments = (*encoded, n_j, order, di, dj, length, self._emission, factor,
-                         highlight, self._grey, shading is not None, threshold, BAND,
-                         self._band_order(axis, dj, height), np.zeros(1, np.int64), inter,
-                         counts)
-            on_threads(lambda i: composite_classified(*arguments), numba.get_num_threads())
+            composite_classified(*encoded, n_j, order, di, dj, length, self._emission, factor,
+                                 highlight, self._grey, shading is not None, threshold, BAND,
+                                 self._band_order(axis, dj, height), numba.get_num_threads(),
+                                 inter, counts)
             plane = volume.origin[axis] + kf * volume.spacing[axis]
             out = np.empty(view.shape + (4,))
             warp(inter, warp_homography(view, volume, axis, plane, (oi, oj)), out, self._grey)

@@ -111,10 +111,10 @@ def _pair(v, w_left, w_right, sigma, emission_code, normal_code, emission, facto
             + q1 * (emission[e1, 2] * factor[n1] + highlight[n1]))
 
 
-@jit
+@parallel_jit
 def composite_classified(run_ptr, run_start, run_end, run_voxel, sigma, emission_code,
                          normal_code, n_j, order, di, dj, length, emission, factor, highlight,
-                         grey, shaded, threshold, band_rows, bands, counter, inter, counts):
+                         grey, shaded, threshold, band_rows, bands, threads, inter, counts):
     """Composite the slices ``order`` (front to back) into ``inter[J, I] = (r, g, b, a)``.
 
     Slice ``k``'s sample for intermediate pixel ``(I, J)`` lies at column ``I + di[k]`` and row
@@ -126,21 +126,23 @@ def composite_classified(run_ptr, run_start, run_end, run_voxel, sigma, emission
     ``emission[e] * factor[n] + highlight[n]`` for its codes ``e`` and ``n`` (``grey``: white
     emission; unless ``shaded``, ``factor`` is 1 and ``highlight`` 0).
 
-    The image is cut into bands of ``band_rows`` rows; a call takes the next band of
-    ``bands`` (the heaviest first) from the shared queue ``counter``
-    (:func:`vrlib._kernels.queue.take`) until none is left, and several threads make the
-    call at once (:func:`vrlib._scheduling.on_threads`). A band walks the slices front to
+    The image is cut into bands of ``band_rows`` rows; each of ``threads`` threads takes the
+    next band of ``bands`` (the heaviest first) from a shared queue
+    (:func:`vrlib._kernels.queue.take`) until none is left. A band walks the slices front to
     back and, in each, its rows in order, so that it reads the encoding sequentially
     (VolPack's object order). Each row is composited in a fixed order: the image does not
     depend on the thread count. ``counts[J]`` gets the samples row ``J`` composited.
     """
-    while True:
-        it = take(counter)
-        if it >= bands.shape[0]:
-            break
-        _composite_band(run_ptr, run_start, run_end, run_voxel, sigma, emission_code,
-                        normal_code, n_j, order, di, dj, length, emission, factor, highlight,
-                        grey, shaded, threshold, band_rows, bands[it], inter, counts)
+    counter = np.zeros(1, np.int64)
+    for _ in prange(threads):
+        while True:
+            it = take(counter)
+            if it >= bands.shape[0]:
+                break
+            _composite_band(run_ptr, run_start, run_end, run_voxel, sigma, emission_code,
+                            normal_code, n_j, order, di, dj, length, emission, factor,
+                            highlight, grey, shaded, threshold, band_rows, bands[it], inter,
+                            counts)
 
 
 @jit
