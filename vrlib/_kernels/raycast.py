@@ -500,8 +500,9 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
     ``lighting`` None only a table's colour (no shading, no gradient opacity), and
     ``skipping`` None leaves out the skipping (``block = 0``). numba drops a branch on a
     None argument before it types the function, so such a kernel compiles in a fraction of
-    the time (a first render's wait); ``True`` compiles that path. ``scratch`` (6 x ``MAX_TAPS``, this call's own) holds
-    the filter's weights and their derivatives along x, y and z.
+    the time (a first render's wait); ``True`` compiles that path. ``scratch``
+    (6 x ``MAX_TAPS``, this call's own) holds the filter's weights and their derivatives
+    along x, y and z.
     """
     # Views without reference counts for the calls per pixel and per sample (the caller
     # keeps the arrays).
