@@ -118,6 +118,7 @@ def test_render_reads_files(tmp_path):
 
 @pytest.mark.parametrize("args, message", [
     (["render", "nothing", "-o", "x.png"], "unknown volume 'nothing'"),
+    (["render", "blobs", "-o", "x.png"], "use random-blobs"),
     (["render", "marschner-lobb:17", "--method", "foo", "-o", "x.png"], "unknown method"),
     (["render", "marschner-lobb:17", "--filter", "lanczos", "-o", "x.png"],
      "unknown filter"),

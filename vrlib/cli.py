@@ -86,6 +86,11 @@ def _number(text):
     return int(value) if value.is_integer() and "." not in text and "e" not in text else value
 
 
+#: Fields built from a list of parts, which a ``name:key=value`` spec cannot give, and the
+#: field to use instead.
+_LISTED_FIELDS = {"blobs": "random-blobs"}
+
+
 def load_volume(spec, *, shape=None, dtype=None, offset=0, frame=None, series=None,
                 scalars=None, nan="error", oblique="refuse", spacing=None):
     """``(volume, field or None)`` from a command-line volume spec."""
@@ -136,8 +141,12 @@ def load_volume(spec, *, shape=None, dtype=None, offset=0, frame=None, series=No
                          f"files; it reads {endings}, and a DICOM series as a folder of "
                          "slice files")
     field_name, *rest = spec.split(":")
+    if field_name in _LISTED_FIELDS:
+        raise UsageError(f"field {field_name!r} takes a list of blobs, which a command line "
+                         f"cannot give: use {_LISTED_FIELDS[field_name]} "
+                         "(count=, seed=, region=)")
     if field_name not in data_gen.FIELDS:
-        known = ", ".join(data_gen.FIELDS)
+        known = ", ".join(name for name in data_gen.FIELDS if name not in _LISTED_FIELDS)
         raise UsageError(f"unknown volume {spec!r}: not a file, and {field_name!r} is not a "
                          f"field (fields: {known}; named volumes: "
                          f"{', '.join(data_gen.DATASETS)})")
