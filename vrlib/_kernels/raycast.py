@@ -383,6 +383,23 @@ def _pixel_start(r, c, camera, height, width, mask, box_lo, box_hi, vol_lo, vol_
     return hit, d, t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, t_first, t_last
 
 
+@jit(inline="always")
+def _loop_views(data, offset, gshape, origin, spacing, camera, light, ramp_x, ramp_y, empty,
+                clearance, bound, scratch):
+    """What both ray-casting kernels hand to the calls in their loops, as views without
+    reference counts (:func:`~vrlib._kernels._jit.borrowed`; the kernel's caller keeps the
+    arrays): the arguments as given, then ``flat`` (``data`` raveled), ``inv`` (the inverse
+    spacing), ``fine_counts`` (the skip grid's shape) and the filter's scratch ``wx, wy, wz,
+    dx, dy, dz`` (the rows of this call's ``scratch``)."""
+    data = borrowed(data)
+    return (data, borrowed(offset), borrowed(gshape), borrowed(origin), borrowed(camera),
+            borrowed(light), borrowed(ramp_x), borrowed(ramp_y), borrowed(empty),
+            borrowed(clearance), borrowed(bound), data.reshape(-1),
+            (1.0 / spacing[0], 1.0 / spacing[1], 1.0 / spacing[2]), empty.shape,
+            borrowed(scratch[0]), borrowed(scratch[1]), borrowed(scratch[2]),
+            borrowed(scratch[3]), borrowed(scratch[4]), borrowed(scratch[5]))
+
+
 @jit
 def raycast_preintegrated(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo,
                           vol_hi, camera, height, width, ds, fkind, fp0, fp1, fp2, radius,
@@ -401,19 +418,12 @@ def raycast_preintegrated(data, offset, gshape, origin, spacing, box_lo, box_hi,
     each end's value, ``pre_emission`` on the density's grid
     (:class:`vrlib.transfer.PreintegratedTable`). The other arguments are as for
     :func:`raycast`."""
-    # Views without reference counts for the call per ray (the caller keeps the arrays).
-    data, offset, gshape, origin = borrowed(data), borrowed(offset), borrowed(gshape), \
-        borrowed(origin)
-    camera, light = borrowed(camera), borrowed(light)
+    data, offset, gshape, origin, camera, light, ramp_x, ramp_y, empty, clearance, bound, \
+        flat, inv, fine_counts, wx, wy, wz, dx, dy, dz = _loop_views(
+            data, offset, gshape, origin, spacing, camera, light, ramp_x, ramp_y, empty,
+            clearance, bound, scratch)
     pre_density, pre_psi = borrowed(pre_density), borrowed(pre_psi)
     pre_emission, pre_mean = borrowed(pre_emission), borrowed(pre_mean)
-    ramp_x, ramp_y = borrowed(ramp_x), borrowed(ramp_y)
-    empty, clearance, bound = borrowed(empty), borrowed(clearance), borrowed(bound)
-    wx, wy, wz = borrowed(scratch[0]), borrowed(scratch[1]), borrowed(scratch[2])
-    dx, dy, dz = borrowed(scratch[3]), borrowed(scratch[4]), borrowed(scratch[5])
-    flat = borrowed(data.reshape(-1))
-    inv = (1.0 / spacing[0], 1.0 / spacing[1], 1.0 / spacing[2])
-    fine_counts = empty.shape
     tiles_across = (width + tile_w - 1) // tile_w
     while True:
         it = take(counter)
@@ -504,19 +514,11 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
     (6 x ``MAX_TAPS``, this call's own) holds the filter's weights and their derivatives
     along x, y and z.
     """
-    # Views without reference counts for the calls per pixel and per sample (the caller
-    # keeps the arrays).
-    data, offset, gshape, origin = borrowed(data), borrowed(offset), borrowed(gshape), \
-        borrowed(origin)
-    camera, emit_tab, light = borrowed(camera), borrowed(emit_tab), borrowed(light)
-    ramp_x, ramp_y = borrowed(ramp_x), borrowed(ramp_y)
-    empty, clearance, bound, multiplier = borrowed(empty), borrowed(clearance), \
-        borrowed(bound), borrowed(multiplier)
-    wx, wy, wz = borrowed(scratch[0]), borrowed(scratch[1]), borrowed(scratch[2])
-    dx, dy, dz = borrowed(scratch[3]), borrowed(scratch[4]), borrowed(scratch[5])
-    flat = borrowed(data.reshape(-1))
-    inv = (1.0 / spacing[0], 1.0 / spacing[1], 1.0 / spacing[2])
-    fine_counts = empty.shape
+    data, offset, gshape, origin, camera, light, ramp_x, ramp_y, empty, clearance, bound, \
+        flat, inv, fine_counts, wx, wy, wz, dx, dy, dz = _loop_views(
+            data, offset, gshape, origin, spacing, camera, light, ramp_x, ramp_y, empty,
+            clearance, bound, scratch)
+    emit_tab, multiplier = borrowed(emit_tab), borrowed(multiplier)
     tiles_across = (width + tile_w - 1) // tile_w
     nx = data.shape[2]
     nxy = data.shape[1] * data.shape[2]
