@@ -23,7 +23,7 @@ import math
 import numpy as np
 from numba import prange
 
-from vrlib._kernels._jit import jit, parallel_jit
+from vrlib._kernels._jit import at, jit, parallel_jit, put
 from vrlib._kernels.queue import take
 from vrlib._kernels.shading import half_vector, phong_terms
 
@@ -45,11 +45,11 @@ def shade_table(normals, light, direction, ka, kd, ks, shininess, factor, highli
 def _open(links, row, i):
     """First pixel at or after ``i`` of ``row`` that is not opaque; compresses the path."""
     root = i
-    while links[row, root] != root:
-        root = links[row, root]
-    while links[row, i] != root:
-        following = links[row, i]
-        links[row, i] = root
+    while at(links, (row, root)) != root:
+        root = at(links, (row, root))
+    while at(links, (row, i)) != root:
+        following = at(links, (row, i))
+        put(links, (row, i), root)
         i = following
     return root
 
@@ -60,13 +60,13 @@ def _stream(run_start, run_end, run_voxel, c, e, s_i, before, pos, following):
     advanced past the runs that end before it, whether a run covers it (a run
     ``[start, end)`` covers the pixels ``[start - s_i - before, end - s_i)``), the base with
     ``voxel = base + pixel`` there, and ``following`` cut to where that state ends."""
-    while c < e and run_end[c] - s_i <= pos:
+    while c < e and at(run_end, c) - s_i <= pos:
         c += 1
     if c < e:
-        lo = run_start[c] - s_i - before
+        lo = at(run_start, c) - s_i - before
         if lo <= pos:
-            return c, True, run_voxel[c] + 1 - run_start[c] + s_i, min(following,
-                                                                        run_end[c] - s_i)
+            return c, True, at(run_voxel, c) + 1 - at(run_start, c) + s_i, min(
+                following, at(run_end, c) - s_i)
         return c, False, 0, min(following, lo)
     return c, False, 0, following
 
@@ -88,27 +88,27 @@ def _pair(v, w_left, w_right, sigma, emission_code, normal_code, emission, facto
     weighted extinction and colours ``(extinction, r, g, b)``, each colour weighted by its
     voxel's extinction (``grey``: white emission; unless ``shaded``, ``factor`` is 1 and
     ``highlight`` 0)."""
-    q0 = w_left * sigma[v]
-    q1 = w_right * sigma[v + 1]
+    q0 = w_left * at(sigma, v)
+    q1 = w_right * at(sigma, v + 1)
     if grey and not shaded:
         return q0 + q1, q0 + q1, 0.0, 0.0
     if grey:
-        n0, n1 = normal_code[v], normal_code[v + 1]
-        lum = q0 * (factor[n0] + highlight[n0]) + q1 * (factor[n1] + highlight[n1])
+        n0, n1 = at(normal_code, v), at(normal_code, v + 1)
+        lum = q0 * (at(factor, n0) + at(highlight, n0)) + q1 * (at(factor, n1) + at(highlight, n1))
         return q0 + q1, lum, 0.0, 0.0
-    e0, e1 = emission_code[v], emission_code[v + 1]
+    e0, e1 = at(emission_code, v), at(emission_code, v + 1)
     if not shaded:
-        return (q0 + q1, q0 * emission[e0, 0] + q1 * emission[e1, 0],
-                q0 * emission[e0, 1] + q1 * emission[e1, 1],
-                q0 * emission[e0, 2] + q1 * emission[e1, 2])
-    n0, n1 = normal_code[v], normal_code[v + 1]
+        return (q0 + q1, q0 * at(emission, (e0, 0)) + q1 * at(emission, (e1, 0)),
+                q0 * at(emission, (e0, 1)) + q1 * at(emission, (e1, 1)),
+                q0 * at(emission, (e0, 2)) + q1 * at(emission, (e1, 2)))
+    n0, n1 = at(normal_code, v), at(normal_code, v + 1)
     return (q0 + q1,
-            q0 * (emission[e0, 0] * factor[n0] + highlight[n0])
-            + q1 * (emission[e1, 0] * factor[n1] + highlight[n1]),
-            q0 * (emission[e0, 1] * factor[n0] + highlight[n0])
-            + q1 * (emission[e1, 1] * factor[n1] + highlight[n1]),
-            q0 * (emission[e0, 2] * factor[n0] + highlight[n0])
-            + q1 * (emission[e1, 2] * factor[n1] + highlight[n1]))
+            q0 * (at(emission, (e0, 0)) * at(factor, n0) + at(highlight, n0))
+            + q1 * (at(emission, (e1, 0)) * at(factor, n1) + at(highlight, n1)),
+            q0 * (at(emission, (e0, 1)) * at(factor, n0) + at(highlight, n0))
+            + q1 * (at(emission, (e1, 1)) * at(factor, n1) + at(highlight, n1)),
+            q0 * (at(emission, (e0, 2)) * at(factor, n0) + at(highlight, n0))
+            + q1 * (at(emission, (e1, 2)) * at(factor, n1) + at(highlight, n1)))
 
 
 @parallel_jit
@@ -246,13 +246,15 @@ def _composite_band(run_ptr, run_start, run_end, run_voxel, sigma, emission_code
                         cr *= scale
                         cg = cr if grey else cg * scale
                         cb = cr if grey else cb * scale
-                        remaining = 1.0 - inter[row, pixel, 3]
-                        inter[row, pixel, 0] += remaining * cr
-                        inter[row, pixel, 1] += remaining * cg
-                        inter[row, pixel, 2] += remaining * cb
-                        inter[row, pixel, 3] += remaining * alpha
-                        if inter[row, pixel, 3] >= threshold:
-                            links[r, pixel] = pixel + 1
+                        acc = at(inter, (row, pixel, 3))
+                        remaining = 1.0 - acc
+                        put(inter, (row, pixel, 0), at(inter, (row, pixel, 0)) + remaining * cr)
+                        put(inter, (row, pixel, 1), at(inter, (row, pixel, 1)) + remaining * cg)
+                        put(inter, (row, pixel, 2), at(inter, (row, pixel, 2)) + remaining * cb)
+                        acc += remaining * alpha
+                        put(inter, (row, pixel, 3), acc)
+                        if acc >= threshold:
+                            put(links, (r, pixel), pixel + 1)
                             opaque[r] += 1
                     pixel = _open(links, r, pixel + 1)
                 pos = following

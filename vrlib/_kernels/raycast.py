@@ -25,7 +25,7 @@ import math
 
 from numba import literally
 
-from vrlib._kernels._jit import borrowed, jit
+from vrlib._kernels._jit import at, borrowed, jit
 from vrlib._kernels.camera import pixel_ray, ray_box
 from vrlib._kernels.filters import CUBIC, TENT
 from vrlib._kernels.preintegration import bilinear_channel, psi_at
@@ -36,6 +36,7 @@ from vrlib._kernels.sampling import (
     separable4,
     tricubic,
     trilinear,
+    trilinear_inside,
 )
 from vrlib._kernels.shading import classify_by_gradient, modulate_by_gradient
 from vrlib._kernels.tables import interpolate, interpolate_channel, lookup
@@ -117,6 +118,55 @@ def _cut_segment(k, ds, t_first, t_last):
     a = max(k * ds, t_first)
     b = min((k + 1) * ds, t_last)
     return 0.5 * (a + b), (b - a) / ds
+
+
+@jit(inline="always")
+def _entry_at(table, i, w):
+    """Entry ``i + w`` of a 1-D table, linearly interpolated (``i`` from
+    :func:`~vrlib._kernels.tables.lookup`)."""
+    return at(table, i) + w * (at(table, i + 1) - at(table, i))
+
+
+@jit(inline="always")
+def _row_at(table, i, w, channel):
+    """Column ``channel`` of a 2-D table at row ``i + w``, as :func:`_entry_at`."""
+    return at(table, (i, channel)) + w * (at(table, (i + 1, channel)) - at(table, (i, channel)))
+
+
+@jit(inline="always")
+def _inside(k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in, t_out):
+    """Whether sample ``k`` lies in ``[t_in, t_out)`` and in a cell whose 8 corners lie
+    inside the volume (``0 <= u < g - 1`` on each axis, ``g1 = g - 1``): where
+    :func:`~vrlib._kernels.sampling.trilinear` takes its fast path."""
+    t = (k + 0.5) * ds
+    ux = ax + t * bx
+    uy = ay + t * by
+    uz = az + t * bz
+    return (t_in <= t < t_out and 0.0 <= ux < gx1 and 0.0 <= uy < gy1
+            and 0.0 <= uz < gz1)
+
+
+@jit
+def _inside_end(k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in, t_out, k_last):
+    """End (exclusive) of the run of samples from ``k`` on that are :func:`_inside` and
+    before the cut segment ``k_last`` (-1: none), for a sample ``k`` that is. A sample's
+    index position, as computed, is monotone in ``k`` (rounding keeps the order of exact
+    values), so the run is one interval: guessed from where the ray leaves the cells, then
+    corrected by testing its end."""
+    t_end = t_out
+    for a, b, g1 in ((ax, bx, gx1), (ay, by, gy1), (az, bz, gz1)):
+        if b > 0.0:
+            t_end = min(t_end, (g1 - a) / b)
+        elif b < 0.0:
+            t_end = min(t_end, -a / b)
+    end = max(min(math.floor(t_end / ds + 0.5), k_last if k_last >= 0 else 1 << 62), k + 1)
+    while end > k + 1 and not _inside(end - 1, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1,
+                                      t_in, t_out):
+        end -= 1
+    while (k_last < 0 or end < k_last) and _inside(end, ds, ax, ay, az, bx, by, bz, gx1, gy1,
+                                                   gz1, t_in, t_out):
+        end += 1
+    return end
 
 
 @jit(inline="always")
@@ -525,6 +575,8 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
     oz, oy, ox = offset[0], offset[1], offset[2]
     gz, gy, gx = gshape[0], gshape[1], gshape[2]
     ntab = alpha_tab.shape[0]
+    shift = oz * nxy + oy * nx + ox
+    gx1, gy1, gz1 = float(gx - 1), float(gy - 1), float(gz - 1)
     adaptive = block > 0 and multiplier.shape == empty.shape
     while True:
         it = take(counter)
@@ -551,6 +603,34 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                 # The common case, its loop stripped: tent filter, white unshaded emission,
                 # nothing to skip. The same arithmetic as the general loop below.
                 while True:
+                    if k != k_first and k != k_last and _inside(
+                            k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in, t_out):
+                        # A run of samples in cells inside the volume: no test per sample.
+                        end = _inside_end(k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in,
+                                          t_out, k_last)
+                        j = k
+                        while j < end:
+                            t = (j + 0.5) * ds
+                            ux = ax + t * bx
+                            uy = ay + t * by
+                            uz = az + t * bz
+                            ix, iy, iz = int(ux), int(uy), int(uz)  # floor: u >= 0
+                            value = trilinear_inside(flat, nx, nxy, shift, ix, iy, iz, ux - ix,
+                                                     uy - iy, uz - iz)
+                            j += 1
+                            i, w = lookup((value - tstart) * tinv, ntab)
+                            alpha = _entry_at(alpha_tab, i, w)
+                            if alpha > 0.0:
+                                remaining = 1.0 - acc_a
+                                acc_r += remaining * alpha
+                                acc_a += remaining * alpha
+                                if acc_a >= threshold:
+                                    break
+                        taken += j - k
+                        k = j
+                        if acc_a >= threshold:
+                            break
+                        continue
                     t = (k + 0.5) * ds
                     fraction = 1.0
                     if k == k_first or k == k_last:
@@ -565,7 +645,7 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                     taken += 1
                     k += 1
                     i, w = lookup((value - tstart) * tinv, ntab)
-                    alpha = alpha_tab[i] + w * (alpha_tab[i + 1] - alpha_tab[i])
+                    alpha = _entry_at(alpha_tab, i, w)
                     if not alpha > 0.0:
                         continue
                     if fraction != 1.0:
@@ -641,7 +721,7 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                     # Classify: segment opacity 1 - exp(-density ds) (eq 1.4) and colour
                     # E alpha (eq 1.9), from the table.
                     i, w = lookup((value - tstart) * tinv, ntab)
-                    alpha = alpha_tab[i] + w * (alpha_tab[i + 1] - alpha_tab[i])
+                    alpha = _entry_at(alpha_tab, i, w)
                     if not alpha > 0.0:
                         continue  # a transparent segment adds exactly nothing
                     if grey and not by_gradient:
@@ -661,9 +741,9 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                         if not alpha > 0.0:
                             continue
                     else:
-                        cr = color_tab[i, 0] + w * (color_tab[i + 1, 0] - color_tab[i, 0])
-                        cg = color_tab[i, 1] + w * (color_tab[i + 1, 1] - color_tab[i, 1])
-                        cb = color_tab[i, 2] + w * (color_tab[i + 1, 2] - color_tab[i, 2])
+                        cr = _row_at(color_tab, i, w, 0)
+                        cg = _row_at(color_tab, i, w, 1)
+                        cb = _row_at(color_tab, i, w, 2)
                     if fraction != 1.0:  # a segment cut by the volume's face, or a long one
                         part = _part_of_segment(alpha, fraction)
                         cr *= part / alpha

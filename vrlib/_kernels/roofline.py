@@ -16,7 +16,7 @@ import math
 import numpy as np
 from numba import prange
 
-from vrlib._kernels._jit import parallel_jit
+from vrlib._kernels._jit import at, parallel_jit
 from vrlib._kernels.footprint import planar_at, planar_row
 from vrlib._kernels.sampling import cubic_weights, lerp_corners, trilinear
 from vrlib._kernels.tables import lookup
@@ -34,7 +34,8 @@ def sample_rays(brick, starts, direction, steps, cubic, b, c, out):
     """Sum of ``steps`` samples along each ray ``starts[r] + k direction`` (index coordinates
     ``(x, y, z)`` of ``brick[z, y, x]``), one sum per ray in ``out``: trilinear, or with
     ``cubic`` the Mitchell-Netravali (B, C) cubic's 4 x 4 x 4 taps. The brick is read flat from
-    one base index per sample, with no bounds checks (the rays stay inside it)."""
+    one base index per sample, with no bounds checks (the rays stay inside it) and no test for
+    a negative index (:data:`~vrlib._kernels._jit.at`)."""
     flat = brick.reshape(-1)
     nx = brick.shape[2]
     nxy = brick.shape[1] * brick.shape[2]
@@ -57,13 +58,15 @@ def sample_rays(brick, starts, direction, steps, cubic, b, c, out):
                     plane = 0.0
                     for ky in range(4):
                         row = first + kz * nxy + ky * nx
-                        plane += wy[ky] * (wx[0] * flat[row] + wx[1] * flat[row + 1]
-                                           + wx[2] * flat[row + 2] + wx[3] * flat[row + 3])
+                        plane += wy[ky] * (wx[0] * at(flat, row) + wx[1] * at(flat, row + 1)
+                                           + wx[2] * at(flat, row + 2)
+                                           + wx[3] * at(flat, row + 3))
                     acc += wz[kz] * plane
             else:
-                acc += lerp_corners(flat[base], flat[base + 1], flat[base + nx],
-                                    flat[base + nx + 1], flat[base + nxy], flat[base + nxy + 1],
-                                    flat[base + nxy + nx], flat[base + nxy + nx + 1], tx, ty, tz)
+                acc += lerp_corners(at(flat, base), at(flat, base + 1), at(flat, base + nx),
+                                    at(flat, base + nx + 1), at(flat, base + nxy),
+                                    at(flat, base + nxy + 1), at(flat, base + nxy + nx),
+                                    at(flat, base + nxy + nx + 1), tx, ty, tz)
             ux += dx
             uy += dy
             uz += dz
@@ -167,7 +170,7 @@ def march_rays(brick, starts, direction, steps, classify, tstart, tinv, alpha_ta
                               ay + t * direction[1], az + t * direction[2])
             if classify:
                 i, w = lookup((value - tstart) * tinv, ntab)
-                alpha = alpha_tab[i] + w * (alpha_tab[i + 1] - alpha_tab[i])
+                alpha = at(alpha_tab, i) + w * (at(alpha_tab, i + 1) - at(alpha_tab, i))
                 acc += (1.0 - acc) * alpha
             else:
                 acc += value

@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from vrlib._kernels._jit import jit
+from vrlib._kernels._jit import at, jit
 from vrlib._kernels.filters import (
     BOX,
     GAUSSIAN,
@@ -92,31 +92,28 @@ def trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz):
     iz = int(math.floor(uz))
     tx, ty, tz = ux - ix, uy - iy, uz - iz
     if 0 <= ix and ix + 1 < gx and 0 <= iy and iy + 1 < gy and 0 <= iz and iz + 1 < gz:
-        base = (iz - oz) * nxy + (iy - oy) * nx + (ix - ox)
-        d000 = flat[base]
-        d001 = flat[base + 1]
-        d010 = flat[base + nx]
-        d011 = flat[base + nx + 1]
-        d100 = flat[base + nxy]
-        d101 = flat[base + nxy + 1]
-        d110 = flat[base + nxy + nx]
-        d111 = flat[base + nxy + nx + 1]
-    else:
-        x0 = clamp(ix, gx) - ox
-        x1 = clamp(ix + 1, gx) - ox
-        y0 = (clamp(iy, gy) - oy) * nx
-        y1 = (clamp(iy + 1, gy) - oy) * nx
-        z0 = (clamp(iz, gz) - oz) * nxy
-        z1 = (clamp(iz + 1, gz) - oz) * nxy
-        d000 = flat[z0 + y0 + x0]
-        d001 = flat[z0 + y0 + x1]
-        d010 = flat[z0 + y1 + x0]
-        d011 = flat[z0 + y1 + x1]
-        d100 = flat[z1 + y0 + x0]
-        d101 = flat[z1 + y0 + x1]
-        d110 = flat[z1 + y1 + x0]
-        d111 = flat[z1 + y1 + x1]
-    return lerp_corners(d000, d001, d010, d011, d100, d101, d110, d111, tx, ty, tz)
+        return trilinear_inside(flat, nx, nxy, oz * nxy + oy * nx + ox, ix, iy, iz, tx, ty, tz)
+    x0 = clamp(ix, gx) - ox
+    x1 = clamp(ix + 1, gx) - ox
+    y0 = (clamp(iy, gy) - oy) * nx
+    y1 = (clamp(iy + 1, gy) - oy) * nx
+    z0 = (clamp(iz, gz) - oz) * nxy
+    z1 = (clamp(iz + 1, gz) - oz) * nxy
+    return lerp_corners(at(flat, z0 + y0 + x0), at(flat, z0 + y0 + x1), at(flat, z0 + y1 + x0),
+                        at(flat, z0 + y1 + x1), at(flat, z1 + y0 + x0), at(flat, z1 + y0 + x1),
+                        at(flat, z1 + y1 + x0), at(flat, z1 + y1 + x1), tx, ty, tz)
+
+
+@jit(inline="always")
+def trilinear_inside(flat, nx, nxy, shift, ix, iy, iz, tx, ty, tz):
+    """:func:`trilinear` in a cell whose 8 corners lie inside the volume: cell
+    ``(ix, iy, iz)`` (global indices) at fractions ``(tx, ty, tz)``, its corners read at fixed
+    offsets from one index. ``shift = oz nxy + oy nx + ox`` turns a global sample's flat index
+    into ``flat``'s."""
+    base = iz * nxy + iy * nx + ix - shift
+    return lerp_corners(at(flat, base), at(flat, base + 1), at(flat, base + nx),
+                        at(flat, base + nx + 1), at(flat, base + nxy), at(flat, base + nxy + 1),
+                        at(flat, base + nxy + nx), at(flat, base + nxy + nx + 1), tx, ty, tz)
 
 
 @jit(inline="always")
@@ -201,8 +198,8 @@ def four_taps(flat, nx, nxy, oz, oy, ox, gz, gy, gx, fx, fy, fz, wx, wy, wz):
             plane = 0.0
             for cy in range(4):
                 row = base + cz * nxy + cy * nx
-                plane += wy[cy] * (wx[0] * flat[row] + wx[1] * flat[row + 1]
-                                   + wx[2] * flat[row + 2] + wx[3] * flat[row + 3])
+                plane += wy[cy] * (wx[0] * at(flat, row) + wx[1] * at(flat, row + 1)
+                                   + wx[2] * at(flat, row + 2) + wx[3] * at(flat, row + 3))
             value += wz[cz] * plane
         return value
     x0 = clamp(fx, gx) - ox
@@ -214,8 +211,8 @@ def four_taps(flat, nx, nxy, oz, oy, ox, gz, gy, gx, fx, fy, fz, wx, wy, wz):
         plane = 0.0
         for cy in range(4):
             row = kz + (clamp(fy + cy, gy) - oy) * nx
-            plane += wy[cy] * (wx[0] * flat[row + x0] + wx[1] * flat[row + x1]
-                               + wx[2] * flat[row + x2] + wx[3] * flat[row + x3])
+            plane += wy[cy] * (wx[0] * at(flat, row + x0) + wx[1] * at(flat, row + x1)
+                               + wx[2] * at(flat, row + x2) + wx[3] * at(flat, row + x3))
         value += wz[cz] * plane
     return value
 

@@ -16,7 +16,7 @@ import math
 import numpy as np
 from numba import prange
 
-from vrlib._kernels._jit import jit, parallel_jit
+from vrlib._kernels._jit import at, jit, parallel_jit, put
 from vrlib._kernels.filters import CUBIC, MAX_TAPS, TENT, weight
 from vrlib._kernels.sampling import clamp, cubic_weights, filter_taps
 from vrlib._kernels.shading import classify_by_gradient
@@ -505,22 +505,49 @@ def _warp_pixel(inter, x, y, out, row, c, grey):
     if x >= 0.0 and y >= 0.0 and x <= n_i - 1 and y <= n_j - 1:
         i = min(int(x), n_i - 2)
         j = min(int(y), n_j - 2)
-        if not (inter[j, i, 3] == 0.0 and inter[j, i + 1, 3] == 0.0
-                and inter[j + 1, i, 3] == 0.0 and inter[j + 1, i + 1, 3] == 0.0):
+        if not (at(inter, (j, i, 3)) == 0.0 and at(inter, (j, i + 1, 3)) == 0.0
+                and at(inter, (j + 1, i, 3)) == 0.0 and at(inter, (j + 1, i + 1, 3)) == 0.0):
             tx = x - i
             ty = y - j
             for ch in range(4):
                 if grey and (ch == 1 or ch == 2):
                     continue
-                top = (1 - tx) * inter[j, i, ch] + tx * inter[j, i + 1, ch]
-                bottom = (1 - tx) * inter[j + 1, i, ch] + tx * inter[j + 1, i + 1, ch]
-                out[row, c, ch] = min(max((1 - ty) * top + ty * bottom, 0.0), 1.0)
+                top = (1 - tx) * at(inter, (j, i, ch)) + tx * at(inter, (j, i + 1, ch))
+                bottom = ((1 - tx) * at(inter, (j + 1, i, ch))
+                          + tx * at(inter, (j + 1, i + 1, ch)))
+                put(out, (row, c, ch), min(max((1 - ty) * top + ty * bottom, 0.0), 1.0))
             if grey:
-                out[row, c, 1] = out[row, c, 0]
-                out[row, c, 2] = out[row, c, 0]
+                put(out, (row, c, 1), at(out, (row, c, 0)))
+                put(out, (row, c, 2), at(out, (row, c, 0)))
             return
     for ch in range(4):
-        out[row, c, ch] = 0.0
+        put(out, (row, c, ch), 0.0)
+
+
+@jit
+def seen_box(inter):
+    """The columns and rows of ``inter`` that hold a pixel that is not transparent,
+    ``(i_lo, i_hi, j_lo, j_hi)`` as floats; ``-3`` each where none does (no column then
+    meets the box). Each row is scanned from its two ends inwards, so only the transparent
+    margins are read in full."""
+    n_j, n_i = inter.shape[0], inter.shape[1]
+    i_lo, i_hi, j_lo, j_hi = n_i, -1, n_j, -1
+    for j in range(n_j):
+        i = 0
+        while i < min(i_lo, n_i) and at(inter, (j, i, 3)) == 0.0:
+            i += 1
+        if i == n_i:  # a transparent row
+            continue
+        j_lo = min(j_lo, j)
+        j_hi = j
+        i_lo = min(i_lo, i)
+        i = n_i - 1
+        while i > i_hi and at(inter, (j, i, 3)) == 0.0:
+            i -= 1
+        i_hi = max(i_hi, i)
+    if j_hi < 0:
+        return np.array([-3.0, -3.0, -3.0, -3.0])
+    return np.array([float(i_lo), float(i_hi), float(j_lo), float(j_hi)])
 
 
 @jit(inline="always")
@@ -557,12 +584,12 @@ def _warp_affine(inter, m, out, grey, seen):
         stop = max(min(x1, y1), first)
         for c in range(first):
             for ch in range(4):
-                out[row, c, ch] = 0.0
+                put(out, (row, c, ch), 0.0)
         for c in range(first, stop):
             _warp_pixel(inter, m[0, 0] * c + ax, m[1, 0] * c + ay, out, row, c, grey)
         for c in range(stop, width):
             for ch in range(4):
-                out[row, c, ch] = 0.0
+                put(out, (row, c, ch), 0.0)
 
 
 @parallel_jit
@@ -586,10 +613,6 @@ def warp(inter, homography, out, grey=False):
     homography (orthographic views: ``D = 1``) takes no division; ``grey`` images (red, green
     and blue equal) interpolate one colour channel."""
     if homography[2, 0] == 0.0 and homography[2, 1] == 0.0 and homography[2, 2] == 1.0:
-        cols = np.flatnonzero(inter[..., 3].any(axis=0))
-        rows = np.flatnonzero(inter[..., 3].any(axis=1))
-        seen = (np.array([cols[0], cols[-1], rows[0], rows[-1]], np.float64) if cols.size
-                else np.array([-3.0, -3.0, -3.0, -3.0]))  # nothing shows: no column meets it
-        _warp_affine(inter, homography, out, grey, seen)
+        _warp_affine(inter, homography, out, grey, seen_box(inter))
     else:
         _warp_projective(inter, homography, out, grey)
