@@ -302,6 +302,43 @@ def test_early_termination_stays_within_its_bound():
 
 
 @pytest.mark.parametrize("ends", ["lattice", "exact"])
+@pytest.mark.parametrize("projection", ["orthographic", "perspective"])
+@pytest.mark.parametrize("brick", [False, True], ids=["whole", "brick"])
+def test_runs_inside_the_volume_equal_the_general_loop(ends, projection, brick):
+    """The common case (tent filter, grey, nothing to skip) samples its runs of cells inside
+    the volume without a test per sample, two samples a step: its image and sample count
+    equal, bit for bit, the general loop's (forced by a skip grid whose blocks are all
+    visible), over rays that stop by early termination inside a run, rays cut by the
+    volume's faces, a perspective eye and a brick's own box."""
+    vol = data_gen.make_field("marschner-lobb").sample((23, 20, 21))
+    view = View.orbit(azimuth=33, elevation=21, size=37, projection=projection)
+    filt, transfer = vrlib.make_filter("trilinear"), Glow(40.0)
+    ext = vol.extent
+    first, box = 0, (ext[:, 0].copy(), ext[:, 1].copy())
+    data = vol.data
+    if brick:  # the upper half along z, with one ghost sample below
+        first = 10
+        data = np.ascontiguousarray(vol.data[first - 1:])
+        first -= 1
+        box[0][2] = ext[2, 0] + 10 * vol.spacing[2]
+    visible = np.zeros((3, 3, 3), bool)
+    grid = (visible, vrlib.skipping.clearance(visible), 8, np.ones(view.shape, bool))
+    images = []
+    for skip in (None, grid):
+        rgba, samples = cast_rays(
+            data, offset=(first, 0, 0), global_shape=vol.shape, origin=vol.origin,
+            spacing=vol.spacing, box=box, view=view, filt=filt, transfer=transfer,
+            ds=0.7 * vol.spacing.min(), value_range=reconstructed_range(vol, filt),
+            early_termination=0.95, skip=skip, exact_ends=ends == "exact")
+        images.append((rgba, samples))
+    (runs, taken_runs), (general, taken_general) = images
+    assert np.array_equal(runs, general)
+    assert taken_runs == taken_general
+    assert (runs[..., 3] >= 0.95).mean() > 0.2  # rays do stop early
+    assert 0.0 < (runs[..., 3] > 0.0).mean() < 1.0
+
+
+@pytest.mark.parametrize("ends", ["lattice", "exact"])
 @pytest.mark.parametrize("filt,transfer", [("catmull-rom", Glow(1.0)),
                                            ("box", Glow(1.0, shading=Phong()))],
                          ids=["catmull-rom", "box-shaded"])

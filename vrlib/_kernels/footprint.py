@@ -9,7 +9,7 @@ import math
 import numpy as np
 from numba import prange
 
-from vrlib._kernels._jit import jit, parallel_jit
+from vrlib._kernels._jit import at, jit, parallel_jit
 from vrlib._kernels.filters import weight
 
 RADIAL, PLANAR = 0, 1
@@ -49,8 +49,8 @@ def planar_at(extent, planar, j, ty, u):
         return 0.0
     i = min(int(x), n - 2)
     tx = x - i
-    return ((1.0 - ty) * ((1.0 - tx) * planar[j, i] + tx * planar[j, i + 1])
-            + ty * ((1.0 - tx) * planar[j + 1, i] + tx * planar[j + 1, i + 1]))
+    return ((1.0 - ty) * ((1.0 - tx) * at(planar, (j, i)) + tx * at(planar, (j, i + 1)))
+            + ty * ((1.0 - tx) * at(planar, (j + 1, i)) + tx * at(planar, (j + 1, i + 1))))
 
 
 @jit

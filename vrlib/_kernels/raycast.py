@@ -146,6 +146,20 @@ def _inside(k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in, t_out):
             and 0.0 <= uz < gz1)
 
 
+@jit(inline="always")
+def _inside_alpha(k, ds, ax, ay, az, bx, by, bz, flat, nx, nxy, shift, tstart, tinv, alpha_tab):
+    """Segment opacity of sample ``k``, one that is :func:`_inside`: the tent filter's
+    value there (no test of the cell) through the opacity table."""
+    t = (k + 0.5) * ds
+    ux = ax + t * bx
+    uy = ay + t * by
+    uz = az + t * bz
+    ix, iy, iz = int(ux), int(uy), int(uz)  # floor: u >= 0
+    value = trilinear_inside(flat, nx, nxy, shift, ix, iy, iz, ux - ix, uy - iy, uz - iz)
+    i, w = lookup((value - tstart) * tinv, alpha_tab.shape[0])
+    return _entry_at(alpha_tab, i, w)
+
+
 @jit
 def _inside_end(k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in, t_out, k_last):
     """End (exclusive) of the run of samples from ``k`` on that are :func:`_inside` and
@@ -608,24 +622,31 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                         # A run of samples in cells inside the volume: no test per sample.
                         end = _inside_end(k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in,
                                           t_out, k_last)
+                        # Two samples a step: the second's loads start before the first is
+                        # composited (it is dropped if the first ends the ray).
                         j = k
                         while j < end:
-                            t = (j + 0.5) * ds
-                            ux = ax + t * bx
-                            uy = ay + t * by
-                            uz = az + t * bz
-                            ix, iy, iz = int(ux), int(uy), int(uz)  # floor: u >= 0
-                            value = trilinear_inside(flat, nx, nxy, shift, ix, iy, iz, ux - ix,
-                                                     uy - iy, uz - iz)
+                            alpha = _inside_alpha(j, ds, ax, ay, az, bx, by, bz, flat, nx, nxy,
+                                                  shift, tstart, tinv, alpha_tab)
+                            second = 0.0
+                            if j + 1 < end:
+                                second = _inside_alpha(j + 1, ds, ax, ay, az, bx, by, bz, flat,
+                                                       nx, nxy, shift, tstart, tinv, alpha_tab)
                             j += 1
-                            i, w = lookup((value - tstart) * tinv, ntab)
-                            alpha = _entry_at(alpha_tab, i, w)
                             if alpha > 0.0:
                                 remaining = 1.0 - acc_a
                                 acc_r += remaining * alpha
                                 acc_a += remaining * alpha
                                 if acc_a >= threshold:
                                     break
+                            if j < end:
+                                j += 1
+                                if second > 0.0:
+                                    remaining = 1.0 - acc_a
+                                    acc_r += remaining * second
+                                    acc_a += remaining * second
+                                    if acc_a >= threshold:
+                                        break
                         taken += j - k
                         k = j
                         if acc_a >= threshold:
@@ -648,10 +669,13 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                     alpha = _entry_at(alpha_tab, i, w)
                     if not alpha > 0.0:
                         continue
-                    if fraction != 1.0:
-                        alpha = _part_of_segment(alpha, fraction)
+                    colour = alpha
+                    if fraction != 1.0:  # as the general loop scales a cut segment's colour
+                        part = _part_of_segment(alpha, fraction)
+                        colour *= part / alpha
+                        alpha = part
                     remaining = 1.0 - acc_a
-                    acc_r += remaining * alpha
+                    acc_r += remaining * colour
                     acc_a += remaining * alpha
                     if acc_a >= threshold:
                         break

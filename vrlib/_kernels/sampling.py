@@ -73,7 +73,7 @@ def reconstruct(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1, fp2, radius, 
             ky = clamp(fy + b, gshape[1]) - offset[1]
             row = 0.0
             for a in range(ntaps):
-                row += wx[a] * data[kz, ky, clamp(fx + a, gshape[2]) - offset[2]]
+                row += wx[a] * at(data, (kz, ky, clamp(fx + a, gshape[2]) - offset[2]))
             value += wz[c] * wy[b] * row
     return value
 
@@ -242,7 +242,7 @@ def gradient(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1, fp2, radius, nta
             row = 0.0
             drow = 0.0
             for a in range(ntaps):
-                v = data[kz, ky, clamp(fx + a, gshape[2]) - offset[2]]
+                v = at(data, (kz, ky, clamp(fx + a, gshape[2]) - offset[2]))
                 row += wx[a] * v
                 drow += dx[a] * v
             gx += wz[c] * wy[b] * drow
