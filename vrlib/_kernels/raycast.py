@@ -147,9 +147,11 @@ def _inside(k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in, t_out):
 
 
 @jit(inline="always")
-def _inside_alpha(k, ds, ax, ay, az, bx, by, bz, flat, nx, nxy, shift, tstart, tinv, alpha_tab):
-    """Segment opacity of sample ``k``, one that is :func:`_inside`: the tent filter's
-    value there (no test of the cell) through the opacity table."""
+def _inside_sample(k, ds, ax, ay, az, bx, by, bz, flat, nx, nxy, shift, tstart, tinv,
+                   alpha_tab):
+    """Sample ``k``, one that is :func:`_inside`: the tent filter's value there (no test of
+    the cell) and its segment opacity from the table, ``(alpha, i, w)`` with the table's row
+    ``i + w``."""
     t = (k + 0.5) * ds
     ux = ax + t * bx
     uy = ay + t * by
@@ -157,7 +159,66 @@ def _inside_alpha(k, ds, ax, ay, az, bx, by, bz, flat, nx, nxy, shift, tstart, t
     ix, iy, iz = int(ux), int(uy), int(uz)  # floor: u >= 0
     value = trilinear_inside(flat, nx, nxy, shift, ix, iy, iz, ux - ix, uy - iy, uz - iz)
     i, w = lookup((value - tstart) * tinv, alpha_tab.shape[0])
-    return _entry_at(alpha_tab, i, w)
+    return _entry_at(alpha_tab, i, w), i, w
+
+
+@jit(inline="always")
+def _over(acc, alpha, i, w, grey, color_tab):
+    """Front-to-back over (eqs 1.7-1.8) of a segment of opacity ``alpha`` and colour from
+    row ``i + w`` of ``color_tab`` (``grey``: the colour is the opacity, and ``acc``'s
+    red, green and blue are equal), onto ``acc = (r, g, b, a)``."""
+    r, g, b, a = acc
+    remaining = 1.0 - a
+    if grey:
+        r += remaining * alpha
+        return r, r, r, a + remaining * alpha
+    return (r + remaining * _row_at(color_tab, i, w, 0),
+            g + remaining * _row_at(color_tab, i, w, 1),
+            b + remaining * _row_at(color_tab, i, w, 2), a + remaining * alpha)
+
+
+@jit
+def _inside_run(k, end, ds, ax, ay, az, bx, by, bz, flat, nx, nxy, shift, tstart, tinv,
+                alpha_tab, color_tab, grey, threshold, acc):
+    """Samples ``k .. end - 1``, all :func:`_inside` (tent filter, classification from the
+    tables, no shading), composited onto ``acc = (r, g, b, a)`` until its opacity reaches
+    ``threshold``: ``(next k, acc)``. The same arithmetic as the general loop, without a
+    test per sample, two samples a step: the second's loads start before the first is
+    composited (it is dropped if the first ends the ray)."""
+    j = k
+    while j < end:
+        alpha, i, w = _inside_sample(j, ds, ax, ay, az, bx, by, bz, flat, nx, nxy, shift,
+                                     tstart, tinv, alpha_tab)
+        second, i2, w2 = 0.0, 0, 0.0
+        if j + 1 < end:
+            second, i2, w2 = _inside_sample(j + 1, ds, ax, ay, az, bx, by, bz, flat, nx, nxy,
+                                            shift, tstart, tinv, alpha_tab)
+        j += 1
+        if alpha > 0.0:
+            acc = _over(acc, alpha, i, w, grey, color_tab)
+            if acc[3] >= threshold:
+                break
+        if j < end:
+            j += 1
+            if second > 0.0:
+                acc = _over(acc, second, i2, w2, grey, color_tab)
+                if acc[3] >= threshold:
+                    break
+    return j, acc
+
+
+@jit(inline="always")
+def _before(t_check, ds, k, end):
+    """``end`` cut to the first sample after ``k`` at or past ``t_check`` (the general
+    loop's next skip check; none when it is infinite)."""
+    if not (-math.inf < t_check < math.inf):
+        return end
+    limit = max(math.ceil(t_check / ds - 0.5), k + 1)
+    while limit > k + 1 and (limit - 0.5) * ds >= t_check:
+        limit -= 1
+    while (limit + 0.5) * ds < t_check:
+        limit += 1
+    return min(end, limit)
 
 
 @jit
@@ -583,6 +644,7 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
             data, offset, gshape, origin, spacing, camera, light, ramp_x, ramp_y, empty,
             clearance, bound, scratch)
     emit_tab, multiplier = borrowed(emit_tab), borrowed(multiplier)
+    alpha_tab, color_tab = borrowed(alpha_tab), borrowed(color_tab)
     tiles_across = (width + tile_w - 1) // tile_w
     nx = data.shape[2]
     nxy = data.shape[1] * data.shape[2]
@@ -622,31 +684,10 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                         # A run of samples in cells inside the volume: no test per sample.
                         end = _inside_end(k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in,
                                           t_out, k_last)
-                        # Two samples a step: the second's loads start before the first is
-                        # composited (it is dropped if the first ends the ray).
-                        j = k
-                        while j < end:
-                            alpha = _inside_alpha(j, ds, ax, ay, az, bx, by, bz, flat, nx, nxy,
-                                                  shift, tstart, tinv, alpha_tab)
-                            second = 0.0
-                            if j + 1 < end:
-                                second = _inside_alpha(j + 1, ds, ax, ay, az, bx, by, bz, flat,
-                                                       nx, nxy, shift, tstart, tinv, alpha_tab)
-                            j += 1
-                            if alpha > 0.0:
-                                remaining = 1.0 - acc_a
-                                acc_r += remaining * alpha
-                                acc_a += remaining * alpha
-                                if acc_a >= threshold:
-                                    break
-                            if j < end:
-                                j += 1
-                                if second > 0.0:
-                                    remaining = 1.0 - acc_a
-                                    acc_r += remaining * second
-                                    acc_a += remaining * second
-                                    if acc_a >= threshold:
-                                        break
+                        j, acc = _inside_run(k, end, ds, ax, ay, az, bx, by, bz, flat, nx,
+                                             nxy, shift, tstart, tinv, alpha_tab, color_tab,
+                                             True, threshold, (acc_r, acc_r, acc_r, acc_a))
+                        acc_r, acc_a = acc[0], acc[3]
                         taken += j - k
                         k = j
                         if acc_a >= threshold:
@@ -728,6 +769,22 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                             uy = ay + t * by
                             uz = az + t * bz
                             fraction = float(m)
+                    if (lighting is None and (filtering is None or fkind == TENT)
+                            and m_block == 1 and k != k_first and k != k_last
+                            and _inside(k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in,
+                                        t_out)):
+                        # A run of samples inside the volume, before the next skip check.
+                        end = _before(t_check, ds, k, _inside_end(
+                            k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in, t_out, k_last))
+                        j, acc = _inside_run(k, end, ds, ax, ay, az, bx, by, bz, flat, nx, nxy,
+                                             shift, tstart, tinv, alpha_tab, color_tab, grey,
+                                             threshold, (acc_r, acc_g, acc_b, acc_a))
+                        acc_r, acc_g, acc_b, acc_a = acc
+                        taken += j - k
+                        k = j
+                        if acc_a >= threshold:
+                            break
+                        continue
                     # The two common filters unrolled, the others through the general loop.
                     if filtering is None or fkind == TENT:
                         value = trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz)
