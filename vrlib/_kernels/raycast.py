@@ -146,7 +146,7 @@ def _inside(k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in, t_out):
             and 0.0 <= uz < gz1)
 
 
-@jit(inline="always")
+@jit
 def _inside_sample(k, ds, ax, ay, az, bx, by, bz, flat, nx, nxy, shift, tstart, tinv,
                    alpha_tab):
     """Sample ``k``, one that is :func:`_inside`: the tent filter's value there (no test of
@@ -162,7 +162,7 @@ def _inside_sample(k, ds, ax, ay, az, bx, by, bz, flat, nx, nxy, shift, tstart, 
     return _entry_at(alpha_tab, i, w), i, w
 
 
-@jit(inline="always")
+@jit
 def _over(acc, alpha, i, w, grey, color_tab):
     """Front-to-back over (eqs 1.7-1.8) of a segment of opacity ``alpha`` and colour from
     row ``i + w`` of ``color_tab`` (``grey``: the colour is the opacity, and ``acc``'s
@@ -175,36 +175,6 @@ def _over(acc, alpha, i, w, grey, color_tab):
     return (r + remaining * _row_at(color_tab, i, w, 0),
             g + remaining * _row_at(color_tab, i, w, 1),
             b + remaining * _row_at(color_tab, i, w, 2), a + remaining * alpha)
-
-
-@jit
-def _inside_run(k, end, ds, ax, ay, az, bx, by, bz, flat, nx, nxy, shift, tstart, tinv,
-                alpha_tab, color_tab, grey, threshold, acc):
-    """Samples ``k .. end - 1``, all :func:`_inside` (tent filter, classification from the
-    tables, no shading), composited onto ``acc = (r, g, b, a)`` until its opacity reaches
-    ``threshold``: ``(next k, acc)``. The same arithmetic as the general loop, without a
-    test per sample, two samples a step: the second's loads start before the first is
-    composited (it is dropped if the first ends the ray)."""
-    j = k
-    while j < end:
-        alpha, i, w = _inside_sample(j, ds, ax, ay, az, bx, by, bz, flat, nx, nxy, shift,
-                                     tstart, tinv, alpha_tab)
-        second, i2, w2 = 0.0, 0, 0.0
-        if j + 1 < end:
-            second, i2, w2 = _inside_sample(j + 1, ds, ax, ay, az, bx, by, bz, flat, nx, nxy,
-                                            shift, tstart, tinv, alpha_tab)
-        j += 1
-        if alpha > 0.0:
-            acc = _over(acc, alpha, i, w, grey, color_tab)
-            if acc[3] >= threshold:
-                break
-        if j < end:
-            j += 1
-            if second > 0.0:
-                acc = _over(acc, second, i2, w2, grey, color_tab)
-                if acc[3] >= threshold:
-                    break
-    return j, acc
 
 
 @jit(inline="always")
@@ -221,7 +191,7 @@ def _before(t_check, ds, k, end):
     return min(end, limit)
 
 
-@jit
+@jit(inline="always")
 def _inside_end(k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in, t_out, k_last):
     """End (exclusive) of the run of samples from ``k`` on that are :func:`_inside` and
     before the cut segment ``k_last`` (-1: none), for a sample ``k`` that is. A sample's
@@ -242,6 +212,42 @@ def _inside_end(k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in, t_out, k_las
                                                    gz1, t_in, t_out):
         end += 1
     return end
+
+
+@jit
+def _inside_run(k, t_check, k_last, t_in, t_out, gx1, gy1, gz1, ds, ax, ay, az, bx, by, bz,
+                flat, nx, nxy, shift, tstart, tinv, alpha_tab, color_tab, grey, threshold, acc):
+    """The run of samples from ``k`` on that are :func:`_inside`, before ``t_check`` (the
+    general loop's next skip check) and the cut segment ``k_last``: tent filter,
+    classification from the tables, no shading, composited onto ``acc = (r, g, b, a)`` until
+    its opacity reaches ``threshold``. Returns ``(next k, acc)``: ``k`` itself where sample
+    ``k`` is not inside. The same arithmetic as the general loop, without a test per sample,
+    two samples a step: the second's loads start before the first is composited (it is
+    dropped if the first ends the ray)."""
+    if not _inside(k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in, t_out):
+        return k, acc
+    end = _before(t_check, ds, k, _inside_end(k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1,
+                                              t_in, t_out, k_last))
+    j = k
+    while j < end:
+        alpha, i, w = _inside_sample(j, ds, ax, ay, az, bx, by, bz, flat, nx, nxy, shift,
+                                     tstart, tinv, alpha_tab)
+        second, i2, w2 = 0.0, 0, 0.0
+        if j + 1 < end:
+            second, i2, w2 = _inside_sample(j + 1, ds, ax, ay, az, bx, by, bz, flat, nx, nxy,
+                                            shift, tstart, tinv, alpha_tab)
+        j += 1
+        if alpha > 0.0:
+            acc = _over(acc, alpha, i, w, grey, color_tab)
+            if acc[3] >= threshold:
+                break
+        if j < end:
+            j += 1
+            if second > 0.0:
+                acc = _over(acc, second, i2, w2, grey, color_tab)
+                if acc[3] >= threshold:
+                    break
+    return j, acc
 
 
 @jit(inline="always")
@@ -675,170 +681,120 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
             acc_b = 0.0
             acc_a = 0.0
             spent = 0.0  # the budget's share this ray has used
-            if filtering is None and lighting is None and skipping is None and grey:
-                # The common case, its loop stripped: tent filter, white unshaded emission,
-                # nothing to skip. The same arithmetic as the general loop below.
-                while True:
-                    if k != k_first and k != k_last and _inside(
-                            k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in, t_out):
-                        # A run of samples in cells inside the volume: no test per sample.
-                        end = _inside_end(k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in,
-                                          t_out, k_last)
-                        j, acc = _inside_run(k, end, ds, ax, ay, az, bx, by, bz, flat, nx,
-                                             nxy, shift, tstart, tinv, alpha_tab, color_tab,
-                                             True, threshold, (acc_r, acc_r, acc_r, acc_a))
-                        acc_r, acc_a = acc[0], acc[3]
-                        taken += j - k
-                        k = j
-                        if acc_a >= threshold:
+            # Samples before t_check lie in a block already found not empty: no check needed
+            # (a sample that rounding puts in an empty block anyway adds exactly nothing).
+            t_check = -math.inf if block > 0 else math.inf
+            m_block = 1  # the step multiplier of the block before t_check, entered at t_enter
+            t_enter = 0.0
+            while True:
+                t = (k + 0.5) * ds
+                fraction = 1.0
+                if k == k_first or k == k_last:
+                    t, fraction = _cut_segment(k, ds, t_first, t_last)
+                    if t < t_in:  # another brick's sample
+                        k += 1
+                        continue
+                if t >= t_out:
+                    break
+                ux = ax + t * bx
+                uy = ay + t * by
+                uz = az + t * bz
+                if skipping is not None and t >= t_check:
+                    k_next, t_check, spent = _skip(
+                        k, ux, uy, uz, ax, ay, az, bx, by, bz, ds, False, empty, clearance,
+                        block, fine_counts, bound, budget, spent, k_first,
+                        k_last, t_first, t_last, adaptive)
+                    if k_next > k:
+                        k = k_next
+                        continue
+                    if adaptive:
+                        m_block = _block_bound(multiplier, block, ux, uy, uz)
+                        t_enter = _entry(ax, ay, az, bx, by, bz, block, fine_counts, ux, uy,
+                                         uz)
+                if skipping is not None and m_block > 1:
+                    # Adaptive steps: one sample, at its middle, for an aligned run of m
+                    # segments inside this block (vrlib.adaptive bounds the change).
+                    k0, m = _long_segment(k, m_block, ds, t_enter, t_check, k_first, k_last)
+                    if m > 1:
+                        k = k0 + m - 1  # the last of the run: k + 1 follows it
+                        t = (k0 + 0.5 * m) * ds
+                        if t < t_in:  # another brick's sample
+                            k += 1
+                            continue
+                        if t >= t_out:
                             break
-                        continue
-                    t = (k + 0.5) * ds
-                    fraction = 1.0
-                    if k == k_first or k == k_last:
-                        t, fraction = _cut_segment(k, ds, t_first, t_last)
-                        if t < t_in:  # another brick's sample
-                            k += 1
-                            continue
-                    if t >= t_out:
-                        break
-                    value = trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ax + t * bx,
-                                      ay + t * by, az + t * bz)
-                    taken += 1
-                    k += 1
-                    i, w = lookup((value - tstart) * tinv, ntab)
-                    alpha = _entry_at(alpha_tab, i, w)
-                    if not alpha > 0.0:
-                        continue
-                    colour = alpha
-                    if fraction != 1.0:  # as the general loop scales a cut segment's colour
-                        part = _part_of_segment(alpha, fraction)
-                        colour *= part / alpha
-                        alpha = part
-                    remaining = 1.0 - acc_a
-                    acc_r += remaining * colour
-                    acc_a += remaining * alpha
-                    if acc_a >= threshold:
-                        break
-                acc_g = acc_r
-                acc_b = acc_r
-            else:
-                # Samples before t_check lie in a block already found not empty: no check needed
-                # (a sample that rounding puts in an empty block anyway adds exactly nothing).
-                t_check = -math.inf if block > 0 else math.inf
-                m_block = 1  # the step multiplier of the block before t_check, entered at t_enter
-                t_enter = 0.0
-                while True:
-                    t = (k + 0.5) * ds
-                    fraction = 1.0
-                    if k == k_first or k == k_last:
-                        t, fraction = _cut_segment(k, ds, t_first, t_last)
-                        if t < t_in:  # another brick's sample
-                            k += 1
-                            continue
-                    if t >= t_out:
-                        break
-                    ux = ax + t * bx
-                    uy = ay + t * by
-                    uz = az + t * bz
-                    if skipping is not None and t >= t_check:
-                        k_next, t_check, spent = _skip(
-                            k, ux, uy, uz, ax, ay, az, bx, by, bz, ds, False, empty, clearance,
-                            block, fine_counts, bound, budget, spent, k_first,
-                            k_last, t_first, t_last, adaptive)
-                        if k_next > k:
-                            k = k_next
-                            continue
-                        if adaptive:
-                            m_block = _block_bound(multiplier, block, ux, uy, uz)
-                            t_enter = _entry(ax, ay, az, bx, by, bz, block, fine_counts, ux, uy,
-                                             uz)
-                    if skipping is not None and m_block > 1:
-                        # Adaptive steps: one sample, at its middle, for an aligned run of m
-                        # segments inside this block (vrlib.adaptive bounds the change).
-                        k0, m = _long_segment(k, m_block, ds, t_enter, t_check, k_first, k_last)
-                        if m > 1:
-                            k = k0 + m - 1  # the last of the run: k + 1 follows it
-                            t = (k0 + 0.5 * m) * ds
-                            if t < t_in:  # another brick's sample
-                                k += 1
-                                continue
-                            if t >= t_out:
-                                break
-                            ux = ax + t * bx
-                            uy = ay + t * by
-                            uz = az + t * bz
-                            fraction = float(m)
-                    if (lighting is None and (filtering is None or fkind == TENT)
-                            and m_block == 1 and k != k_first and k != k_last
-                            and _inside(k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in,
-                                        t_out)):
-                        # A run of samples inside the volume, before the next skip check.
-                        end = _before(t_check, ds, k, _inside_end(
-                            k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in, t_out, k_last))
-                        j, acc = _inside_run(k, end, ds, ax, ay, az, bx, by, bz, flat, nx, nxy,
-                                             shift, tstart, tinv, alpha_tab, color_tab, grey,
-                                             threshold, (acc_r, acc_g, acc_b, acc_a))
+                        ux = ax + t * bx
+                        uy = ay + t * by
+                        uz = az + t * bz
+                        fraction = float(m)
+                if (lighting is None and (filtering is None or fkind == TENT)
+                        and m_block == 1 and k != k_first and k != k_last):
+                    # A run of samples inside the volume, before the next skip check.
+                    j, acc = _inside_run(k, t_check, k_last, t_in, t_out, gx1, gy1, gz1, ds,
+                                         ax, ay, az, bx, by, bz, flat, nx, nxy, shift, tstart,
+                                         tinv, alpha_tab, color_tab, grey, threshold,
+                                         (acc_r, acc_g, acc_b, acc_a))
+                    if j > k:
                         acc_r, acc_g, acc_b, acc_a = acc
                         taken += j - k
                         k = j
                         if acc_a >= threshold:
                             break
                         continue
-                    # The two common filters unrolled, the others through the general loop.
-                    if filtering is None or fkind == TENT:
-                        value = trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz)
-                    elif fkind == CUBIC:
-                        value = tricubic(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz,
-                                         fp0, fp1, fp2)
-                    elif ntaps == 4:
-                        value = separable4(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz,
-                                           fkind, fp0, fp1, fp2, radius)
+                # The two common filters unrolled, the others through the general loop.
+                if filtering is None or fkind == TENT:
+                    value = trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz)
+                elif fkind == CUBIC:
+                    value = tricubic(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz,
+                                     fp0, fp1, fp2)
+                elif ntaps == 4:
+                    value = separable4(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz,
+                                       fkind, fp0, fp1, fp2, radius)
+                else:
+                    value = reconstruct(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1,
+                                        fp2, radius, ntaps, wx, wy, wz)
+                taken += 1
+                k += 1
+                # Classify: segment opacity 1 - exp(-density ds) (eq 1.4) and colour
+                # E alpha (eq 1.9), from the table.
+                i, w = lookup((value - tstart) * tinv, ntab)
+                alpha = _entry_at(alpha_tab, i, w)
+                if not alpha > 0.0:
+                    continue  # a transparent segment adds exactly nothing
+                if grey and not by_gradient:
+                    cr = cg = cb = alpha  # white emission, no shading: colour = opacity
+                elif lighting is not None and (shade or by_gradient):
+                    gx_, gy_, gz_ = gradient(data, offset, gshape, ux, uy, uz, fkind, fp0,
+                                             fp1, fp2, radius, ntaps, wx, wy, wz, dx, dy,
+                                             dz)
+                    if headlight:
+                        lx, ly, lz = -d[0], -d[1], -d[2]
                     else:
-                        value = reconstruct(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1,
-                                            fp2, radius, ntaps, wx, wy, wz)
-                    taken += 1
-                    k += 1
-                    # Classify: segment opacity 1 - exp(-density ds) (eq 1.4) and colour
-                    # E alpha (eq 1.9), from the table.
-                    i, w = lookup((value - tstart) * tinv, ntab)
-                    alpha = _entry_at(alpha_tab, i, w)
+                        lx, ly, lz = light[0], light[1], light[2]
+                    alpha, cr, cg, cb = classify_by_gradient(
+                        alpha, i, w, emit_tab, gx_ * inv[0], gy_ * inv[1], gz_ * inv[2],
+                        by_gradient, ramp_x, ramp_y, shade, lx, ly, lz, d[0], d[1], d[2],
+                        ka, kd, ks, shininess)
                     if not alpha > 0.0:
-                        continue  # a transparent segment adds exactly nothing
-                    if grey and not by_gradient:
-                        cr = cg = cb = alpha  # white emission, no shading: colour = opacity
-                    elif lighting is not None and (shade or by_gradient):
-                        gx_, gy_, gz_ = gradient(data, offset, gshape, ux, uy, uz, fkind, fp0,
-                                                 fp1, fp2, radius, ntaps, wx, wy, wz, dx, dy,
-                                                 dz)
-                        if headlight:
-                            lx, ly, lz = -d[0], -d[1], -d[2]
-                        else:
-                            lx, ly, lz = light[0], light[1], light[2]
-                        alpha, cr, cg, cb = classify_by_gradient(
-                            alpha, i, w, emit_tab, gx_ * inv[0], gy_ * inv[1], gz_ * inv[2],
-                            by_gradient, ramp_x, ramp_y, shade, lx, ly, lz, d[0], d[1], d[2],
-                            ka, kd, ks, shininess)
-                        if not alpha > 0.0:
-                            continue
-                    else:
-                        cr = _row_at(color_tab, i, w, 0)
-                        cg = _row_at(color_tab, i, w, 1)
-                        cb = _row_at(color_tab, i, w, 2)
-                    if fraction != 1.0:  # a segment cut by the volume's face, or a long one
-                        part = _part_of_segment(alpha, fraction)
-                        cr *= part / alpha
-                        cg *= part / alpha
-                        cb *= part / alpha
-                        alpha = part
-                    # Front-to-back over, eqs 1.7-1.8.
-                    remaining = 1.0 - acc_a
-                    acc_r += remaining * cr
-                    acc_g += remaining * cg
-                    acc_b += remaining * cb
-                    acc_a += remaining * alpha
-                    if acc_a >= threshold:
-                        break
+                        continue
+                else:
+                    cr = _row_at(color_tab, i, w, 0)
+                    cg = _row_at(color_tab, i, w, 1)
+                    cb = _row_at(color_tab, i, w, 2)
+                if fraction != 1.0:  # a segment cut by the volume's face, or a long one
+                    part = _part_of_segment(alpha, fraction)
+                    cr *= part / alpha
+                    cg *= part / alpha
+                    cb *= part / alpha
+                    alpha = part
+                # Front-to-back over, eqs 1.7-1.8.
+                remaining = 1.0 - acc_a
+                acc_r += remaining * cr
+                acc_g += remaining * cg
+                acc_b += remaining * cb
+                acc_a += remaining * alpha
+                if acc_a >= threshold:
+                    break
             out[r, c, 0] = acc_r
             out[r, c, 1] = acc_g
             out[r, c, 2] = acc_b
