@@ -494,10 +494,10 @@ def test_bad_volume_or_view():
         render(small_volume(), (30, 20))
 
 
-def test_plain_loop_equals_the_general_loop():
-    """The kernel's stripped loop (tent filter, white unshaded emission, nothing to skip)
-    does the general loop's arithmetic: with skipping on (the general loop, jumping empty
-    blocks) and off (the stripped loop) the image is bit for bit the same."""
+def test_kernel_without_skipping_equals_the_kernel_with_it():
+    """The kernel compiled without skipping (``skipping=None``: nothing to skip) does the
+    arithmetic of the one that skips: with skipping on (jumping empty blocks, runs cut at
+    each skip check) and off the image is bit for bit the same."""
     vol = data_gen.make_field("random-blobs", count=4, seed=2, sigma=(0.08, 0.12)).sample(33)
     ramp = vrlib.LookupTransfer(np.where(np.linspace(0, 1, 33) > 0.2, 20.0, 0.0),
                                 value_range=(0.0, 1.0))
