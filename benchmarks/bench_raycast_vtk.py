@@ -9,8 +9,8 @@ image is the glow alpha. Each image's error is measured against ``render_referen
 analytic field. Scenes: a dense one (Marschner-Lobb under Glow: nothing can be skipped) and a
 sparse one (a few blobs under a thresholded ramp: under 10% of the volume visible).
 
-Prints a table (times are the best of three; ratios are ours / VTK's) and writes
-``build/results/benchmarks/raycast_vtk.json``.
+Prints a table (times are the best of three; ratios are ours / VTK's) and the dense scene's
+times at 512^3, and writes ``build/results/benchmarks/raycast_vtk.json``.
 """
 
 from __future__ import annotations
@@ -31,6 +31,7 @@ import data_gen  # noqa: E402
 import vrlib  # noqa: E402
 
 N, SIZE, STEP = 256, 512, 1.0
+LARGE_N = 512
 VIEW = {"azimuth": 30.0, "elevation": 20.0}
 
 
@@ -113,6 +114,26 @@ class VTKCaster:
 
     def close(self):
         self.plotter.close()
+
+
+def large_volume(view):
+    """The dense scene at ``LARGE_N``^3 (512 MiB as float32), beside VTK's fixed-point caster
+    on 2 threads, times only (the issue's targets hold "also at 512^3"; a reference image at
+    that size would take far longer than the renders)."""
+    field, transfer = scenes()["dense (Marschner-Lobb, Glow)"]
+    volume = field.sample(LARGE_N, dtype=np.float32)
+
+    def ours():
+        return vrlib.render(volume, view, filter="trilinear", transfer=transfer, step=STEP,
+                            threads=2, early_termination=0.999)
+
+    ours()
+    out = {"ours_2t_s": best_of(ours)[0]}
+    caster = VTKCaster(volume, view, transfer, STEP * float(volume.spacing.min()))
+    caster.render(2)
+    out["vtk_2t_s"] = best_of(lambda: caster.render(2))[0]
+    caster.close()
+    return out
 
 
 def jit_times():
@@ -198,12 +219,17 @@ def main():
             f"{s['catmull_rom_2t_s']:.3f} ({s['catmull_rom_rmse']:.1e})",
             f"{s['ours_peak_bytes'] / 2**20:.1f} / {s['volume_bytes'] / 2**20:.0f}",
         ])
+    record["large"] = large_volume(view)
     record["jit"] = jit_times()
     header = ["scene", "visible", "ours 2t (s)", "VTK 2t (s)", "ours/VTK", "ours rmse",
               "VTK rmse", "Msamples/s", "ours 1t/2t", "VTK 1t/2t", "skip speedup",
               "ours step 2 (s, rmse)", "Catmull-Rom (s, rmse)", "peak extra / volume (MiB)"]
     print(f"\n256^3 -> 512^2, parallel projection, step {STEP} voxel, trilinear unless named\n")
     print(markdown(header, rows))
+    large = record["large"]
+    print(f"\nThe dense scene at {LARGE_N}^3 -> {SIZE}^2 (float32, step {STEP}, times only): "
+          f"ours {large['ours_2t_s']:.3f} s, VTK {large['vtk_2t_s']:.3f} s on 2 threads, "
+          f"ours/VTK {large['ours_2t_s'] / large['vtk_2t_s']:.2f}\n")
     for f, t in record["jit"].items():
         print(f"JIT, first render in a new process, {f}: {t['cold_s']:.2f} s with an empty "
               f"cache, {t['cached_s']:.2f} s from the cache (one kernel serves every filter)")
