@@ -57,16 +57,21 @@ def _same(array):
     return array
 
 
-def _indices(context, builder, array_type, index_type, index):
-    """The LLVM indices of ``index`` (an integer, or a tuple of one per dimension) as
-    ``intp``."""
+def _item_pointer(context, builder, array_type, index_type, array, index):
+    """Pointer to ``array[index]`` (``index`` an integer, or a tuple of one per dimension),
+    with no wraparound for a negative index."""
     if isinstance(index_type, types.Integer):
-        return [context.cast(builder, index, index_type, types.intp)]
-    return [context.cast(builder, builder.extract_value(index, n), t, types.intp)
-            for n, t in enumerate(index_type)]
+        indices = [context.cast(builder, index, index_type, types.intp)]
+    else:
+        indices = [context.cast(builder, builder.extract_value(index, n), t, types.intp)
+                   for n, t in enumerate(index_type)]
+    view = context.make_array(array_type)(context, builder, array)
+    return cgutils.get_item_pointer(context, builder, array_type, view, indices,
+                                    wraparound=False)
 
 
 def _known_index(array, index):
+    """Whether ``index`` types as an index of one element of ``array``."""
     if not isinstance(array, types.Array):
         return False
     if isinstance(index, types.Integer):
@@ -84,10 +89,7 @@ def _unchecked_load(typingctx, array, index):
 
     def codegen(context, builder, signature, args):
         aryty, indty = signature.args
-        view = context.make_array(aryty)(context, builder, args[0])
-        pointer = cgutils.get_item_pointer(
-            context, builder, aryty, view, _indices(context, builder, aryty, indty, args[1]),
-            wraparound=False)
+        pointer = _item_pointer(context, builder, aryty, indty, args[0], args[1])
         return context.unpack_value(builder, aryty.dtype, pointer,
                                     align=None if aryty.aligned else 1)
 
@@ -103,10 +105,7 @@ def _unchecked_store(typingctx, array, index, value):
 
     def codegen(context, builder, signature, args):
         aryty, indty, valty = signature.args
-        view = context.make_array(aryty)(context, builder, args[0])
-        pointer = cgutils.get_item_pointer(
-            context, builder, aryty, view, _indices(context, builder, aryty, indty, args[1]),
-            wraparound=False)
+        pointer = _item_pointer(context, builder, aryty, indty, args[0], args[1])
         context.pack_value(builder, aryty.dtype,
                            context.cast(builder, args[2], valty, aryty.dtype), pointer,
                            align=None if aryty.aligned else 1)

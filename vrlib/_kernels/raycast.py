@@ -17,6 +17,11 @@ there (docs/kernel.md).
 
 Classification reads a per-render table of segment opacity and colour
 (:meth:`vrlib.transfer.TransferFunction.segment_table`), linearly interpolated.
+
+A sample's position as computed is monotone in ``k``, so the samples whose cells lie inside
+the volume form one run per ray (or per stretch between skip checks). With the tent filter
+and no shading, :func:`_inside_run` takes that run with no test per sample and the same
+arithmetic, bit for bit (docs/kernel.md).
 """
 
 from __future__ import annotations
