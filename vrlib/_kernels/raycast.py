@@ -30,7 +30,7 @@ import math
 
 from numba import literally
 
-from vrlib._kernels._jit import at, borrowed, jit
+from vrlib._kernels._jit import borrowed, jit
 from vrlib._kernels.camera import pixel_ray, ray_box
 from vrlib._kernels.filters import CUBIC, TENT
 from vrlib._kernels.preintegration import bilinear_channel, psi_at
@@ -44,7 +44,7 @@ from vrlib._kernels.sampling import (
     trilinear_inside,
 )
 from vrlib._kernels.shading import classify_by_gradient, modulate_by_gradient
-from vrlib._kernels.tables import interpolate, interpolate_channel, lookup
+from vrlib._kernels.tables import entry, entry_channel, interpolate, interpolate_channel, lookup
 
 
 @jit
@@ -125,19 +125,6 @@ def _cut_segment(k, ds, t_first, t_last):
     return 0.5 * (a + b), (b - a) / ds
 
 
-@jit(inline="always")
-def _entry_at(table, i, w):
-    """Entry ``i + w`` of a 1-D table, linearly interpolated (``i`` from
-    :func:`~vrlib._kernels.tables.lookup`)."""
-    return at(table, i) + w * (at(table, i + 1) - at(table, i))
-
-
-@jit(inline="always")
-def _row_at(table, i, w, channel):
-    """Column ``channel`` of a 2-D table at row ``i + w``, as :func:`_entry_at`."""
-    return at(table, (i, channel)) + w * (at(table, (i + 1, channel)) - at(table, (i, channel)))
-
-
 @jit
 def _inside(k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in, t_out):
     """Whether sample ``k`` lies in ``[t_in, t_out)`` and in a cell whose 8 corners lie
@@ -165,7 +152,7 @@ def _inside_sample(k, ds, ax, ay, az, bx, by, bz, flat, nx, nxy, shift, tstart, 
     ix, iy, iz = int(ux), int(uy), int(uz)  # floor: u >= 0
     value = trilinear_inside(flat, nx, nxy, shift, ix, iy, iz, ux - ix, uy - iy, uz - iz)
     i, w = lookup((value - tstart) * tinv, alpha_tab.shape[0])
-    return _entry_at(alpha_tab, i, w), i, w
+    return entry(alpha_tab, i, w), i, w
 
 
 @jit
@@ -178,9 +165,9 @@ def _over(acc, alpha, i, w, grey, color_tab):
     if grey:
         r += remaining * alpha
         return r, r, r, a + remaining * alpha
-    return (r + remaining * _row_at(color_tab, i, w, 0),
-            g + remaining * _row_at(color_tab, i, w, 1),
-            b + remaining * _row_at(color_tab, i, w, 2), a + remaining * alpha)
+    return (r + remaining * entry_channel(color_tab, i, w, 0),
+            g + remaining * entry_channel(color_tab, i, w, 1),
+            b + remaining * entry_channel(color_tab, i, w, 2), a + remaining * alpha)
 
 
 @jit(inline="always")
@@ -764,7 +751,7 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                 # Classify: segment opacity 1 - exp(-density ds) (eq 1.4) and colour
                 # E alpha (eq 1.9), from the table.
                 i, w = lookup((value - tstart) * tinv, ntab)
-                alpha = _entry_at(alpha_tab, i, w)
+                alpha = entry(alpha_tab, i, w)
                 if not alpha > 0.0:
                     continue  # a transparent segment adds exactly nothing
                 if grey and not by_gradient:
@@ -784,9 +771,9 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                     if not alpha > 0.0:
                         continue
                 else:
-                    cr = _row_at(color_tab, i, w, 0)
-                    cg = _row_at(color_tab, i, w, 1)
-                    cb = _row_at(color_tab, i, w, 2)
+                    cr = entry_channel(color_tab, i, w, 0)
+                    cg = entry_channel(color_tab, i, w, 1)
+                    cb = entry_channel(color_tab, i, w, 2)
                 if fraction != 1.0:  # a segment cut by the volume's face, or a long one
                     part = _part_of_segment(alpha, fraction)
                     cr *= part / alpha

@@ -19,7 +19,7 @@ from numba import prange
 from vrlib._kernels._jit import at, parallel_jit
 from vrlib._kernels.footprint import planar_at, planar_row
 from vrlib._kernels.sampling import cubic_weights, lerp_corners, trilinear
-from vrlib._kernels.tables import lookup
+from vrlib._kernels.tables import entry, lookup
 
 
 @parallel_jit
@@ -170,7 +170,7 @@ def march_rays(brick, starts, direction, steps, classify, tstart, tinv, alpha_ta
                               ay + t * direction[1], az + t * direction[2])
             if classify:
                 i, w = lookup((value - tstart) * tinv, ntab)
-                alpha = at(alpha_tab, i) + w * (at(alpha_tab, i + 1) - at(alpha_tab, i))
+                alpha = entry(alpha_tab, i, w)
                 acc += (1.0 - acc) * alpha
             else:
                 acc += value

@@ -20,7 +20,7 @@ from vrlib._kernels._jit import at, jit, parallel_jit, put
 from vrlib._kernels.filters import CUBIC, MAX_TAPS, TENT, weight
 from vrlib._kernels.sampling import clamp, cubic_weights, filter_taps
 from vrlib._kernels.shading import classify_by_gradient
-from vrlib._kernels.tables import lookup
+from vrlib._kernels.tables import entry, lookup
 
 
 @jit
@@ -143,7 +143,7 @@ def _over(value, fraction, tstart, tinv, alpha_tab, color_tab, buf, y, x):
     scaled with the opacity (the first and last slices of a volume reach half a slice spacing
     into it; perspective rays cross the slices at their own angles)."""
     i, w = lookup((value - tstart) * tinv, alpha_tab.shape[0])
-    alpha = alpha_tab[i] + w * (alpha_tab[i + 1] - alpha_tab[i])
+    alpha = entry(alpha_tab, i, w)
     if not alpha > 0.0:
         return
     scale = 1.0
@@ -194,7 +194,7 @@ def _over_lit(value, fraction, gx, gy, gz, tstart, tinv, alpha_tab, emit_tab, li
     seen along the unit ray direction ``d`` (``lit[10:13]`` for an orthographic view; a
     headlight shines along ``-d``)."""
     i, w = lookup((value - tstart) * tinv, alpha_tab.shape[0])
-    alpha = alpha_tab[i] + w * (alpha_tab[i + 1] - alpha_tab[i])
+    alpha = entry(alpha_tab, i, w)
     if not alpha > 0.0:
         return
     lx, ly, lz = (-dx, -dy, -dz) if lit[1] != 0.0 else (lit[7], lit[8], lit[9])

@@ -7,7 +7,7 @@ segment_table`, :meth:`~vrlib.TransferFunction.value_table`); a value becomes a 
 
 from __future__ import annotations
 
-from vrlib._kernels._jit import jit
+from vrlib._kernels._jit import at, jit
 
 
 @jit(inline="always")
@@ -21,18 +21,32 @@ def lookup(x, n):
     return i, x - i
 
 
+@jit(inline="always")
+def entry(tab, i, w):
+    """1-D table ``tab`` at grid position ``i + w`` (``i, w`` from :func:`lookup`, so both
+    neighbours lie inside it: read without numba's test for a negative index)."""
+    return at(tab, i) + w * (at(tab, i + 1) - at(tab, i))
+
+
+@jit(inline="always")
+def entry_channel(tab, i, w, channel):
+    """Column ``channel`` of the 2-D table ``tab`` at grid position ``i + w``, as
+    :func:`entry`."""
+    return at(tab, (i, channel)) + w * (at(tab, (i + 1, channel)) - at(tab, (i, channel)))
+
+
 @jit
 def interpolate(tab, start, inv, value):
     """1-D table ``tab`` at ``value``, linearly interpolated and clamped."""
     i, w = lookup((value - start) * inv, tab.shape[0])
-    return tab[i] + w * (tab[i + 1] - tab[i])
+    return entry(tab, i, w)
 
 
 @jit
 def interpolate_channel(tab, start, inv, value, channel):
     """Column ``channel`` of the 2-D table ``tab`` at ``value``, as :func:`interpolate`."""
     i, w = lookup((value - start) * inv, tab.shape[0])
-    return tab[i, channel] + w * (tab[i + 1, channel] - tab[i, channel])
+    return entry_channel(tab, i, w, channel)
 
 
 @jit
