@@ -4,8 +4,9 @@ import numpy as np
 import pytest
 from naive import reconstruct_naive
 
-from vrlib import Glow, LookupTransfer, Volume, make_filter
-from vrlib.skipping import clearance, empty_blocks
+import data_gen
+from vrlib import Glow, LookupTransfer, View, Volume, make_filter, render
+from vrlib.skipping import clearance, empty_blocks, skip_grid
 from vrlib.value_bounds import lattice_sums
 
 
@@ -81,3 +82,43 @@ def test_clearance_is_the_distance_to_the_other_kind(seed):
         assert distance[other].min() == abs(d)
     assert (clearance(np.ones((2, 3, 4), bool)) == 4).all()
     assert (clearance(np.zeros((2, 3, 4), bool)) == -4).all()
+
+
+@pytest.mark.parametrize("method, options", [
+    ("raycast", {}),
+    ("raycast", {"classification": "preintegrated"}),
+    ("raycast", {"skip_budget": 1e-3}),
+    ("splat", {}),
+])
+def test_a_transfer_function_changed_in_place_is_not_served_from_a_cache(method, options):
+    """What renders keep between calls (a volume's skip grid, a transfer function's
+    pre-integrated tables, splatting's culled voxels) is kept under the transfer function's
+    settings (``cache_key``). A table changed in place after a render, so that other blocks
+    show, must render as a new transfer function with those settings does: a grid or table
+    kept under the old settings would leave the newly visible blobs' edges out."""
+    vol = data_gen.make_field("random-blobs", count=3, seed=1).sample(24)
+    view = View.orbit(size=24, azimuth=20.0, elevation=10.0)
+    tf = LookupTransfer([0.0, 0.0, 4.0, 4.0], value_range=vol.value_range)
+    before = render(vol, view, method=method, transfer=tf, **options)
+    tf.density[:] = [0.0, 4.0, 0.0, 0.0]
+    changed = render(vol, view, method=method, transfer=tf, **options)
+    same = LookupTransfer(tf.density.copy(), value_range=vol.value_range)
+    fresh = render(vol, view, method=method, transfer=same, **options)
+    assert np.abs(fresh.rgba - before.rgba).max() > 0.05  # the change shows
+    np.testing.assert_array_equal(changed.rgba, fresh.rgba)
+
+
+def test_the_skip_grid_is_kept_per_filter_and_transfer_function():
+    """One grid per (filter, transfer function settings), built once: equal settings in a
+    new object find it, another filter or scale builds its own, and the grid is read-only
+    (a render cannot spoil it for the next)."""
+    vol = data_gen.make_field("random-blobs", count=3, seed=1).sample(24)
+    tent, cubic = make_filter("trilinear"), make_filter("catmull-rom")
+    grid = skip_grid(vol, tent, Glow(1.0))
+    assert skip_grid(vol, tent, Glow(1.0)) is grid
+    assert skip_grid(vol, cubic, Glow(1.0)) is not grid
+    assert skip_grid(vol, tent, Glow(2.0)) is not grid
+    np.testing.assert_array_equal(grid.empty, empty_blocks(vol, tent, Glow(1.0)))
+    np.testing.assert_array_equal(grid.clearance, clearance(grid.empty))
+    with pytest.raises(ValueError):
+        grid.empty[0, 0, 0] = True

@@ -90,8 +90,8 @@ def test_an_unreachable_tolerance_is_refused_with_what_is_reachable():
 
 
 def test_a_memo_shared_between_renders_changes_no_image():
-    """The pilot's renders share the blocks' densities and footprint (``memo``); each image
-    equals the one rendered without it, for several steps and two views in turn."""
+    """The pilot's renders share the footprint of the volume's skip grid (``memo``); each
+    image equals the one rendered without it, for several steps and two views in turn."""
     from vrlib.filters import make_filter
     from vrlib.raycast import render_raycast
 
@@ -107,4 +107,4 @@ def test_a_memo_shared_between_renders_changes_no_image():
             alone = render_raycast(vol, view, step=step, **options)
             assert np.array_equal(shared.rgba, alone.rgba)
             assert shared.alpha.max() > 0.2
-    assert memo["view"] is views[-1] and memo["skip"][0].any()
+    assert memo["view"] is views[-1] and memo["grid"].empty.any() and memo["mask"].any()

@@ -23,7 +23,7 @@ from vrlib._scheduling import on_threads
 from vrlib.adaptive import step_multipliers
 from vrlib.image import Image, RenderStats
 from vrlib.prefilter import Tally, prepared
-from vrlib.skipping import BLOCK, block_densities, clearance, footprint_mask, visible_box
+from vrlib.skipping import BLOCK, footprint_mask, skip_grid, visible_box
 from vrlib.value_bounds import reconstructed_range
 from vrlib.volume import lattice_extent
 
@@ -94,8 +94,9 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
     the budget from the image at ``step`` (adaptive steps, :mod:`vrlib.adaptive`); 0 takes
     every step. Point classification without shading or gradient opacity only.
 
-    ``memo`` (a dict, empty at first) keeps what depends only on the volume, filter and
-    transfer function (the blocks' densities) and on the view (the pixels whose rays can
+    The skip grid (the blocks' densities, which are empty, how far each is from a block of
+    the other kind) is kept with the volume (:func:`vrlib.skipping.skip_grid`). ``memo`` (a
+    dict, empty at first) keeps what depends on the view as well (the pixels whose rays can
     meet a block) between renders of one scene at several steps: a render to a tolerance's
     pilot images. The images are the same with it or without.
     """
@@ -126,10 +127,8 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
         raise ValueError("skip_budget > 0 skips blocks: it needs empty_space_skipping=True")
     memo = {} if memo is None else memo
     if empty_space_skipping:
-        if "densities" not in memo:
-            memo["densities"] = block_densities(volume, filt, transfer, block=BLOCK)
-        densities = memo["densities"]
-        empty = densities <= 0.0
+        grid = skip_grid(volume, filt, transfer, block=BLOCK)
+        densities, empty = grid.densities, grid.empty
         if skip_budget > 0.0:
             bound = skip_bounds(densities, volume, transfer, ds, value_range)
         if step_budget > 0.0:
@@ -146,11 +145,10 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
             if preint:  # a segment owned outside the box reaches half a step into it
                 box_lo = np.maximum(box_lo - 0.5 * ds, extent[:, 0])
                 box_hi = np.minimum(box_hi + 0.5 * ds, extent[:, 1])
-            if memo.get("view") is not view:
-                memo["view"] = view
-                memo["skip"] = (empty, clearance(empty), BLOCK,
-                                footprint_mask(view, volume, empty, BLOCK))
-            skip = memo["skip"]
+            if memo.get("view") is not view or memo.get("grid") is not grid:
+                memo["view"], memo["grid"] = view, grid
+                memo["mask"] = footprint_mask(view, volume, empty, BLOCK)
+            skip = (empty, grid.clearance, BLOCK, memo["mask"])
     rgba, taken = cast_rays(
         volume.data, offset=(0, 0, 0), global_shape=volume.shape, origin=volume.origin,
         spacing=volume.spacing, box=(box_lo, box_hi), view=view, filt=filt, transfer=transfer,
@@ -164,7 +162,7 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
         bytes=int(volume.data.nbytes + rgba.nbytes),
         seconds=time.perf_counter() - start,
     )
-    return Image(rgba, tally.finish(stats, filt))
+    return Image(rgba, tally.finish(stats, filt), checked=False)  # cast_rays clipped it
 
 
 def segment_options(segment_ends, classification, *, holes=False):
@@ -297,9 +295,10 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
     # Cost of a tile: the pixels whose rays can meet something visible; the threads take the
     # heaviest tiles first. Tiles without such a pixel stay transparent and are not handed
     # out at all.
-    padded = np.zeros((rows * TILE[0], cols * TILE[1]))
+    padded = np.zeros((rows * TILE[0], cols * TILE[1]), np.int32)
     padded[: view.height, : view.width] = skip[3]
-    costs = padded.reshape(rows, TILE[0], cols, TILE[1]).sum(axis=(1, 3)).ravel()
+    costs = padded.reshape(rows, TILE[0], cols * TILE[1]).sum(axis=1)  # a tile's rows
+    costs = costs.reshape(rows, cols, TILE[1]).sum(axis=2).ravel()  # then its columns
     live = np.flatnonzero(costs)
     # One array type per argument (read-only samples, contiguous vectors): every other
     # combination would compile the kernel once more.

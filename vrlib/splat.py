@@ -314,14 +314,14 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
     elif mode == "direct":
         marks = drawable(volume, filt, transfer, mode)
     else:  # the samples less the voxels culled by the transfer function, kept with the volume
-        marks = volume.cached(("splat-drawn", filt, transfer, empty_space_skipping),
+        marks = volume.cached(("splat-drawn", filt, transfer.cache_key(), empty_space_skipping),
                               lambda: drawable(volume, filt, transfer, mode,
                                                cull=empty_space_skipping), keep=2)
     extents = marks
     if lighting and empty_space_skipping:
         # A voxel of value zero still carries a gradient: the rows' extents are those of the
         # voxels whose neighbourhood shows, whatever their values (kept with the volume).
-        extents = volume.cached(("splat-visible", filt, transfer, mode),
+        extents = volume.cached(("splat-visible", filt, transfer.cache_key(), mode),
                                 lambda: visible_neighbourhoods(volume, filt, transfer, mode),
                                 keep=2)
     first, last = row_extents(volume, axis, extents) if (

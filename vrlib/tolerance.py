@@ -95,7 +95,7 @@ def render_within(volume, view, *, filt, transfer, tolerance, empty_space_skippi
     early_termination = 1.0 - TERM_SHARE * tolerance / light
     options = dict(filt=filt, transfer=transfer, early_termination=early_termination,
                    empty_space_skipping=empty_space_skipping, segment_ends="exact",
-                   classification=classification, memo={})  # the pilots' shared skip grids
+                   classification=classification, memo={})  # the pilots' footprint masks
 
     pilot_view = view.resized(tuple(max(PILOT_MIN, n // PILOT_SHRINK) for n in view.shape))
     if pilot_view.height >= view.height and pilot_view.width >= view.width:
