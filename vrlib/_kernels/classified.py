@@ -23,7 +23,7 @@ import math
 import numpy as np
 from numba import prange
 
-from vrlib._kernels._jit import at, jit, parallel_jit, put
+from vrlib._kernels._jit import at, helper_jit, jit, parallel_jit, put
 from vrlib._kernels.queue import take
 from vrlib._kernels.shading import half_vector, phong_terms
 
@@ -145,7 +145,7 @@ def composite_classified(run_ptr, run_start, run_end, run_voxel, sigma, emission
                             counts)
 
 
-@jit
+@helper_jit
 def _composite_band(run_ptr, run_start, run_end, run_voxel, sigma, emission_code, normal_code,
                     n_j, order, di, dj, length, emission, factor, highlight, grey, shaded,
                     threshold, band_rows, band, inter, counts):

@@ -30,7 +30,7 @@ import math
 
 from numba import literally
 
-from vrlib._kernels._jit import borrowed, jit
+from vrlib._kernels._jit import borrowed, helper_jit, jit
 from vrlib._kernels.camera import pixel_ray, ray_box
 from vrlib._kernels.filters import CUBIC, TENT
 from vrlib._kernels.preintegration import bilinear_channel, psi_at
@@ -47,7 +47,7 @@ from vrlib._kernels.shading import classify_by_gradient, modulate_by_gradient
 from vrlib._kernels.tables import entry, entry_channel, interpolate, interpolate_channel, lookup
 
 
-@jit
+@helper_jit
 def _cell(u, cells, count):
     """Block holding index position ``u`` on a grid of ``count`` blocks of ``cells`` cells."""
     b = int(math.floor(u)) // cells
@@ -58,19 +58,19 @@ def _cell(u, cells, count):
     return b
 
 
-@jit
+@helper_jit
 def _is_empty(empty, cells, ux, uy, uz):
     return empty[_cell(uz, cells, empty.shape[0]), _cell(uy, cells, empty.shape[1]),
                  _cell(ux, cells, empty.shape[2])]
 
 
-@jit
+@helper_jit
 def _block_bound(bound, cells, ux, uy, uz):
     return bound[_cell(uz, cells, bound.shape[0]), _cell(uy, cells, bound.shape[1]),
                  _cell(ux, cells, bound.shape[2])]
 
 
-@jit
+@helper_jit
 def _exit(ax, ay, az, bx, by, bz, cells, counts, ux, uy, uz, reach=1):
     """Ray parameter where the ray (index position ``a + t b``) leaves the cube of
     ``2 reach - 1`` blocks a side centred on the block that holds ``(ux, uy, uz)``, on a grid
@@ -86,7 +86,7 @@ def _exit(ax, ay, az, bx, by, bz, cells, counts, ux, uy, uz, reach=1):
     return t_exit
 
 
-@jit
+@helper_jit
 def _entry(ax, ay, az, bx, by, bz, cells, counts, ux, uy, uz):
     """Ray parameter where the ray (index position ``a + t b``) enters the block that holds
     ``(ux, uy, uz)``: :func:`_exit`'s other end."""
@@ -125,7 +125,7 @@ def _cut_segment(k, ds, t_first, t_last):
     return 0.5 * (a + b), (b - a) / ds
 
 
-@jit
+@helper_jit
 def _inside(k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in, t_out):
     """Whether sample ``k`` lies in ``[t_in, t_out)`` and in a cell whose 8 corners lie
     inside the volume (``0 <= u < g - 1`` on each axis, ``g1 = g - 1``): where
@@ -139,7 +139,7 @@ def _inside(k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in, t_out):
             and 0.0 <= uz < gz1)
 
 
-@jit
+@helper_jit
 def _inside_sample(k, ds, ax, ay, az, bx, by, bz, flat, nx, nxy, shift, tstart, tinv,
                    alpha_tab):
     """Sample ``k``, one that is :func:`_inside`: the tent filter's value there (no test of
@@ -155,11 +155,12 @@ def _inside_sample(k, ds, ax, ay, az, bx, by, bz, flat, nx, nxy, shift, tstart, 
     return entry(alpha_tab, i, w), i, w
 
 
-@jit
+@jit(inline="always")
 def _over(acc, alpha, i, w, grey, color_tab):
     """Front-to-back over (eqs 1.7-1.8) of a segment of opacity ``alpha`` and colour from
     row ``i + w`` of ``color_tab`` (``grey``: the colour is the opacity, and ``acc``'s
-    red, green and blue are equal), onto ``acc = (r, g, b, a)``."""
+    red, green and blue are equal), onto ``acc = (r, g, b, a)``. Inlined: compiled on its
+    own it cost the first render about 0.25 s, twice what typing it at its two calls does."""
     r, g, b, a = acc
     remaining = 1.0 - a
     if grey:
@@ -207,7 +208,7 @@ def _inside_end(k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in, t_out, k_las
     return end
 
 
-@jit
+@helper_jit
 def _inside_run(k, t_check, k_last, t_in, t_out, gx1, gy1, gz1, ds, ax, ay, az, bx, by, bz,
                 flat, nx, nxy, shift, tstart, tinv, alpha_tab, color_tab, grey, threshold, acc):
     """The run of samples from ``k`` on that are :func:`_inside`, before ``t_check`` (the
@@ -249,7 +250,7 @@ def _part_of_segment(alpha, fraction):
     return -math.expm1(fraction * math.log1p(-alpha)) if alpha < 1.0 else 1.0
 
 
-@jit
+@helper_jit
 def _other_value(data, flat, nx, nxy, oz, oy, ox, gz, gy, gx, offset, gshape, ux, uy, uz,
                  fkind, fp0, fp1, fp2, radius, ntaps, wx, wy, wz):
     """The value at global index position ``(ux, uy, uz)`` for every filter but the tent,
@@ -320,7 +321,7 @@ def _skip(k, ux, uy, uz, ax, ay, az, bx, by, bz, ds, by_front, empty, clearance,
     return k_next, -math.inf, spent
 
 
-@jit
+@helper_jit
 def _preintegrated_ray(tent, data, flat, offset, gshape, inv, d, ax, ay, az, bx, by, bz, t_in,
                        t_out, k, ds, k_first, k_last, t_first, t_last, fkind, fp0, fp1, fp2,
                        radius, ntaps, start, vinv, density, psi, emission, step, grey,
@@ -446,7 +447,7 @@ def _preintegrated_ray(tent, data, flat, offset, gshape, inv, d, ax, ay, az, bx,
     return acc_r, acc_g, acc_b, acc_a, taken
 
 
-@jit
+@helper_jit
 def _step_segment(front, back, length, start, inv, density, emission, grey):
     """A pre-integrated segment of ``length`` across a step at its middle (the box filter):
     half a segment at the front value over half at the back value, exactly. Returns

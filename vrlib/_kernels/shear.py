@@ -16,14 +16,14 @@ import math
 import numpy as np
 from numba import prange
 
-from vrlib._kernels._jit import at, jit, parallel_jit, put
+from vrlib._kernels._jit import at, helper_jit, jit, parallel_jit, put
 from vrlib._kernels.filters import CUBIC, MAX_TAPS, TENT, weight
 from vrlib._kernels.sampling import clamp, cubic_weights, filter_taps
 from vrlib._kernels.shading import classify_by_gradient
 from vrlib._kernels.tables import entry, lookup
 
 
-@jit
+@helper_jit
 def _line_taps(fkind, fp0, fp1, fp2, radius, ntaps, pos, w):
     """First tap of position ``pos`` on a line, its ``ntaps`` weights in ``w``: closed forms for
     the tent (2 taps) and the cubics (4 taps, the pieces evaluated once each), the filter's
@@ -186,7 +186,7 @@ def _inside_range(inverse, shift, limits, x, y, n):
     return max(0, int(math.floor(z_lo)) - 1), min(n - 1, int(math.ceil(z_hi)) + 1)
 
 
-@jit
+@helper_jit
 def _over_lit(value, fraction, gx, gy, gz, tstart, tinv, alpha_tab, emit_tab, lit, ramp_x,
               ramp_y, buf, y, x, dx, dy, dz):
     """:func:`_over` for a sample classified by its gradient ``g`` too (shading, gradient
@@ -347,7 +347,7 @@ def composite_slices(vol, front_to_back, inverse2, shift, limits, tstart, tinv, 
         counts[y] = done
 
 
-@jit
+@helper_jit
 def _slice_sum(slices, k, rows, i0, ntaps, wi, wj):
     """Slice ``k`` at taps ``i0 ..`` of rows ``rows``, weighted ``wi`` along and ``wj`` across
     the rows; columns clamped to the slice only near its ends."""

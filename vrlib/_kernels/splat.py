@@ -26,7 +26,7 @@ import math
 import numpy as np
 from numba import prange
 
-from vrlib._kernels._jit import borrowed, jit, parallel_jit
+from vrlib._kernels._jit import borrowed, helper_jit, jit, parallel_jit
 from vrlib._kernels.camera import (
     FORWARD,
     PIXEL,
@@ -54,7 +54,7 @@ from vrlib._kernels.tables import interpolate, interpolate_channel, lookup, piec
 SHEET, DIRECT, IMAGE = 0, 1, 2
 
 
-@jit
+@helper_jit
 def _q_range(camera, height, x0, y0, z0, dx, dy, dz, nq, row_lo, row_hi):
     """Indices ``q`` in ``[0, nq)`` of the points ``(x0, y0, z0) + q (dx, dy, dz)`` whose image
     row can lie in ``[row_lo, row_hi]``: a superset, found from the row's monotone (affine or,
@@ -149,7 +149,7 @@ def _composite(out, r, c, value, length, vstart, vinv, dens_tab, emit_tab):
     out[r, c, 3] += weight
 
 
-@jit
+@helper_jit
 def _composite_lit(out, r, c, value, gx, gy, gz, length, vstart, vinv, dens_tab, emit_tab, lit,
                    ramp_x, ramp_y, dx, dy, dz):
     """:func:`_composite` for a segment classified by its mean gradient ``g`` too (shading,
@@ -174,7 +174,7 @@ def _composite_lit(out, r, c, value, gx, gy, gz, length, vstart, vinv, dens_tab,
     out[r, c, 3] += remaining * alpha
 
 
-@jit
+@helper_jit
 def cumulated(cumulative, radius, x):
     """The running integral of the 1-D kernel up to ``x`` (voxels), from its table over
     ``[-radius, radius]``."""
@@ -188,7 +188,7 @@ def cumulated(cumulative, radius, x):
     return cumulative[m] + (y - m) * (cumulative[m + 1] - cumulative[m])
 
 
-@jit
+@helper_jit
 def _window(base, slope, lo, hi, first, last):
     """The integers ``x`` in ``[first, last]`` with ``base + slope x`` in ``[lo, hi]``
     (``first > last`` when none), widened by one for rounding."""
@@ -207,7 +207,7 @@ def _window(base, slope, lo, hi, first, last):
     return max(first, int(math.floor(a)) - 1), min(last, int(math.ceil(b)) + 1)
 
 
-@jit
+@helper_jit
 def _clipped(fkind, extent, extent_v, extent_s, sigma, radial, planar, partial, u, v, rho2,
              s_lo, s_hi):
     """The footprint at plane offsets ``(u, v)`` restricted to ``[s_lo, s_hi]`` along the line
@@ -229,7 +229,7 @@ def _clipped(fkind, extent, extent_v, extent_s, sigma, radial, planar, partial, 
             - partial_at(partial, extent_s, j, i, ty, tx, s_lo))
 
 
-@jit
+@helper_jit
 def _support_image(camera, height, width, x, y, z, hx, hy, hz, row_c, col_c, depth, extent_s):
     """Rows and columns ``(row_lo, row_hi, col_lo, col_hi)`` spanned by the image of the box
     ``(x, y, z) +- (hx, hy, hz)`` in perspective: its corners' projections, or where a corner
@@ -256,7 +256,7 @@ def _support_image(camera, height, width, x, y, z, hx, hy, hz, row_c, col_c, dep
     return row_lo, row_hi, col_lo, col_hi
 
 
-@jit
+@helper_jit
 def _slanted(table, reach, slope, kind, p0, p1, p2, radius, nodes, weights, cuts, o, d, vx,
              vy, vz, spacing, axis, pa, qa, lo, hi):
     """Perspective footprint of a separable kernel for the ray ``o + t d`` itself: from the
@@ -284,7 +284,7 @@ def _slanted(table, reach, slope, kind, p0, p1, p2, radius, nodes, weights, cuts
                                                       nodes, weights, a, e, cuts)
 
 
-@jit
+@helper_jit
 def _flush(mode, s, r0, r1, width, axis, origin, spacing, radius, cumulative, z_lo, z_hi,
            slab_width, last_pass, sheet, touched, opaque, t_in, t_out, enter, leave, along,
            cosines, held_length, last_length, out, threshold, vstart, vinv, dens_tab, emit_tab,
