@@ -2,7 +2,8 @@
 
 The ceilings come from :func:`vrlib.roofline.measure`: STREAM-triad bandwidth, and the peak rate
 of each method's inner loop on cache-resident data: trilinear and Catmull-Rom samples along
-rays (ray casting), footprint-table pixels (splatting), 1-D resampled samples with per-output
+rays (ray casting; trilinear also in packets of 8 rays in vector form, the packet ceiling
+beside the scalar one), footprint-table pixels (splatting), 1-D resampled samples with per-output
 weights (the shear passes) and 2-D slice samples at one translation (shear-warp). Every method
 then renders three scenes (dense Marschner-Lobb under Glow, a dense Gaussian blob, six sparse
 blobs under a thresholded ramp) at 256^3 -> 512^2, step 1, and its rate is divided by the
@@ -76,6 +77,8 @@ def main():
     threads = numba.config.NUMBA_NUM_THREADS
     limits = {t: roofline.measure(threads=t) for t in sorted({1, threads})}
     columns = {"trilinear_float32": "trilinear f32", "trilinear_float64": "trilinear f64",
+               "packet_trilinear_float32": "packets f32",
+               "packet_trilinear_float64": "packets f64",
                "tricubic_float32": "tricubic f32", "footprint_trilinear": "footprint tent",
                "footprint_catmull-rom": "footprint C-R",
                "resample_trilinear": "1-D resample 2 taps",
@@ -86,6 +89,10 @@ def main():
     print("## This machine's ceilings (M per second)\n")
     print(markdown(["threads", "triad GB/s", *columns.values()], rows))
     ceiling = limits[threads]
+    print("\nPackets of 8 rays sampled in vector form (gathers) against the scalar loop, "
+          f"{threads} threads: float32 "
+          f"{ceiling['packet_trilinear_float32'] / ceiling['trilinear_float32']:.2f}x, "
+          f"float64 {ceiling['packet_trilinear_float64'] / ceiling['trilinear_float64']:.2f}x")
     results = []
     for scene, (field, transfer) in scenes().items():
         volume = field.sample(N)

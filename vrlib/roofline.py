@@ -8,6 +8,9 @@ ceiling (``make bench``, chapter 4):
   (the ceiling of any pass that streams the volume from memory);
 * ``trilinear``: trilinear samples per second along rays inside a brick that stays in cache,
   float32 and float64 samples (the ceiling of ray casting with the tent filter);
+* ``packet_trilinear``: the same with eight rays sampled at once in vector form, gathers and
+  vector arithmetic (:mod:`vrlib._kernels.packets`): the ceiling of a packet kernel's
+  sampling, beside the scalar one;
 * ``tricubic``: the same with a 4 x 4 x 4 Mitchell-Netravali cubic (Catmull-Rom): the
   ceiling of every 4-tap filter (the cubics, the Gaussian);
 * ``footprint``: footprint-table pixels per second drawn into a cache-resident sheet, for the
@@ -32,6 +35,7 @@ import numpy as np
 
 from vrlib import validate
 from vrlib._kernels import roofline as _kernel
+from vrlib._kernels.packets import LANES
 from vrlib.cost import measure as _time
 from vrlib.footprint import footprint
 from vrlib.view import View
@@ -120,7 +124,8 @@ def measure(*, threads=None, repeats=5, elements=1 << 24, rays=1 << 16):
     -------
     dict
         ``bandwidth`` (bytes/s), ``trilinear_float32``, ``trilinear_float64``,
-        ``tricubic_float32`` and ``tricubic_float64`` (samples/s), ``footprint_trilinear``
+        ``packet_trilinear_float32``, ``packet_trilinear_float64``, ``tricubic_float32``
+        and ``tricubic_float64`` (samples/s), ``footprint_trilinear``
         and ``footprint_catmull-rom`` (pixels/s), ``resample_trilinear``,
         ``resample_catmull-rom``, ``slice_trilinear`` and ``slice_catmull-rom`` (samples/s;
         named by the filter whose 1-D kernel they use), and ``threads``.
@@ -129,9 +134,10 @@ def measure(*, threads=None, repeats=5, elements=1 << 24, rays=1 << 16):
     --------
     >>> limits = measure(repeats=1, elements=1 << 16, rays=1 << 10)
     >>> sorted(limits)   # doctest: +NORMALIZE_WHITESPACE
-    ['bandwidth', 'footprint_catmull-rom', 'footprint_trilinear', 'resample_catmull-rom',
-     'resample_trilinear', 'slice_catmull-rom', 'slice_trilinear', 'threads',
-     'tricubic_float32', 'tricubic_float64', 'trilinear_float32', 'trilinear_float64']
+    ['bandwidth', 'footprint_catmull-rom', 'footprint_trilinear', 'packet_trilinear_float32',
+     'packet_trilinear_float64', 'resample_catmull-rom', 'resample_trilinear',
+     'slice_catmull-rom', 'slice_trilinear', 'threads', 'tricubic_float32',
+     'tricubic_float64', 'trilinear_float32', 'trilinear_float64']
     >>> all(v > 0 for v in limits.values())   # rates only: comparing them is a benchmark's job
     True
     """
@@ -145,6 +151,9 @@ def measure(*, threads=None, repeats=5, elements=1 << 24, rays=1 << 16):
         direction = np.array([0.36, 0.48, 0.8])
         starts = _rays(rays, direction)
         sums = np.empty(rays)
+        # The packets' rays: the same, the last repeated to fill the last packet.
+        packed = np.concatenate([starts, np.repeat(starts[-1:], -rays % LANES, axis=0)])
+        packed_sums = np.empty(packed.shape[0])
         rng = np.random.default_rng(1)
         samples = rays * STEPS
         for dtype in (np.float32, np.float64):
@@ -153,6 +162,9 @@ def measure(*, threads=None, repeats=5, elements=1 << 24, rays=1 << 16):
                 seconds, _ = _time(lambda brick=brick, cubic=cubic: _kernel.sample_rays(
                     brick, starts, direction, STEPS, cubic, 0.0, 0.5, sums), repeats=repeats)
                 out[f"{name}_{np.dtype(dtype).name}"] = samples / seconds
+            seconds, _ = _time(lambda brick=brick: _kernel.sample_packets(
+                brick, packed, direction, STEPS, packed_sums), repeats=repeats)
+            out[f"packet_trilinear_{np.dtype(dtype).name}"] = packed.shape[0] * STEPS / seconds
         out.update(_other_ceilings(repeats, rays, rng))
         out["threads"] = numba.get_num_threads()
         return out

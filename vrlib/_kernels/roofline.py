@@ -6,7 +6,8 @@ and 2-D resampled slice samples (shear-warp).
 Each kernel does the work of a renderer's inner loop and nothing else: no classification, no
 bounds checks (positions are kept inside the brick by construction), rays advanced
 incrementally. They set the ceilings the renderers are measured against
-(:mod:`vrlib.roofline`).
+(:mod:`vrlib.roofline`). :func:`sample_packets` samples eight rays at a time in vector form
+(:mod:`vrlib._kernels.packets`): the packet ceiling beside the scalar one.
 """
 
 from __future__ import annotations
@@ -16,8 +17,9 @@ import math
 import numpy as np
 from numba import prange
 
-from vrlib._kernels._jit import at, parallel_jit
+from vrlib._kernels._jit import at, jit, parallel_jit
 from vrlib._kernels.footprint import planar_at, planar_row
+from vrlib._kernels.packets import LANES, trilinear_packet
 from vrlib._kernels.sampling import cubic_weights, lerp_corners, trilinear
 from vrlib._kernels.tables import entry, lookup
 
@@ -71,6 +73,48 @@ def sample_rays(brick, starts, direction, steps, cubic, b, c, out):
             uy += dy
             uz += dz
         out[r] = acc
+
+
+@jit(inline="always")
+def _lanes(values, first, axis):
+    """``values[first + l, axis]`` for the ``LANES`` (8) lanes of a packet, as a tuple."""
+    return (values[first, axis], values[first + 1, axis], values[first + 2, axis],
+            values[first + 3, axis], values[first + 4, axis], values[first + 5, axis],
+            values[first + 6, axis], values[first + 7, axis])
+
+
+@jit(inline="always")
+def _every(value):
+    """``value`` in each lane of a packet."""
+    return (value, value, value, value, value, value, value, value)
+
+
+@jit(inline="always")
+def _plus(a, b):
+    """Lane by lane ``a + b`` of two packets."""
+    return (a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3], a[4] + b[4], a[5] + b[5],
+            a[6] + b[6], a[7] + b[7])
+
+
+@parallel_jit
+def sample_packets(brick, starts, direction, steps, out):
+    """:func:`sample_rays` with the trilinear filter, ``LANES`` rays at a time: each packet
+    of neighbouring rays (``starts[p LANES:(p + 1) LANES]``; their number a multiple of
+    ``LANES``) takes its samples together, in vector form
+    (:func:`~vrlib._kernels.packets.trilinear_packet`)."""
+    flat = brick.reshape(-1)
+    nx = brick.shape[2]
+    nxy = brick.shape[1] * brick.shape[2]
+    dx, dy, dz = _every(direction[0]), _every(direction[1]), _every(direction[2])
+    for p in prange(starts.shape[0] // LANES):
+        first = p * LANES
+        ux, uy, uz = _lanes(starts, first, 0), _lanes(starts, first, 1), _lanes(starts, first, 2)
+        acc = _every(0.0)
+        for _ in range(steps):
+            acc = _plus(acc, trilinear_packet(flat, nx, nxy, ux, uy, uz))
+            ux, uy, uz = _plus(ux, dx), _plus(uy, dy), _plus(uz, dz)
+        for lane in range(LANES):
+            out[first + lane] = acc[lane]
 
 
 @parallel_jit
