@@ -22,7 +22,8 @@ RENDERERS = sorted({fn.__module__ for fn in vrlib.METHODS.values()} | {"vrlib.re
 SHARED_KERNELS = {"vrlib._kernels._jit", "vrlib._kernels.filters", "vrlib._kernels.sampling",
                   "vrlib._kernels.camera", "vrlib._kernels.tables",
                   "vrlib._kernels.shading", "vrlib._kernels.footprint",
-                  "vrlib._kernels.preintegration", "vrlib._kernels.queue"}
+                  "vrlib._kernels.preintegration", "vrlib._kernels.queue",
+                  "vrlib._kernels.packets"}
 
 
 def module_name(path):
