@@ -251,9 +251,10 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
         Sample spacing along rays, world units.
     value_range : (float, float)
         Bounds on reconstructed values (for the classification table).
-    skip : (empty, coarse, block, mask) or None
-        Empty-space skipping grids (global blocks) and the pixels whose rays can meet a
-        non-empty block, or None to sample everywhere.
+    skip : (empty, clearance, block, mask) or None
+        Empty-space skipping grids (global blocks of ``block`` cells a side, a power of
+        two), each block's clearance (:func:`vrlib.skipping.clearance`) and the pixels whose
+        rays can meet a non-empty block, or None to sample everywhere.
     exact_ends : bool
         Cut the segments at the whole volume's faces to their part inside it (never at a
         brick's own faces, so that bricks take exactly the serial samples).
@@ -286,6 +287,9 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
     if skip is None:
         skip = (np.zeros((1, 1, 1), dtype=bool), np.zeros((1, 1, 1), np.int64), 0,
                 np.ones(view.shape, dtype=bool))
+    elif skip[2] <= 0 or skip[2] & (skip[2] - 1):
+        raise ValueError(f"skip's block must be a power of two (cells per block), got "
+                         f"{skip[2]}")
     ramp = transfer.gradient_opacity
     by_gradient = (np.zeros(2), np.zeros(2), False) if ramp is None else (
         ramp.magnitudes, ramp.factors, True)

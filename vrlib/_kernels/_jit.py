@@ -17,6 +17,7 @@ from __future__ import annotations
 import functools
 
 import numba
+import numba.cpython.unsafe.numbers
 from numba import types
 from numba.core import cgutils
 from numba.extending import intrinsic
@@ -125,6 +126,16 @@ def _plain_load(array, index):
 def _plain_store(array, index, value):
     array[index] = value
 
+
+def _python_trailing_zeros(n):
+    return (n & -n).bit_length() - 1
+
+
+trailing_zeros = (_python_trailing_zeros if numba.config.DISABLE_JIT
+                  else numba.cpython.unsafe.numbers.trailing_zeros)
+"""``trailing_zeros(n)``: the number of zero bits below ``n``'s lowest set bit (``n > 0``),
+one instruction compiled: ``log2(n)`` for a power of two, so that ``i >> trailing_zeros(n)``
+is ``i // n`` without an integer division (which takes 10 to 20 cycles here)."""
 
 borrowed = _same if numba.config.DISABLE_JIT else _without_meminfo
 """``borrowed(array)``: ``array`` itself, for use inside a kernel call that its caller keeps

@@ -30,7 +30,7 @@ import math
 
 from numba import literally
 
-from vrlib._kernels._jit import borrowed, helper_jit, jit
+from vrlib._kernels._jit import borrowed, helper_jit, jit, trailing_zeros
 from vrlib._kernels.camera import pixel_ray, ray_box
 from vrlib._kernels.filters import CUBIC, TENT
 from vrlib._kernels.preintegration import bilinear_channel, psi_at
@@ -49,8 +49,9 @@ from vrlib._kernels.tables import entry, entry_channel, interpolate, interpolate
 
 @helper_jit
 def _cell(u, cells, count):
-    """Block holding index position ``u`` on a grid of ``count`` blocks of ``cells`` cells."""
-    b = int(math.floor(u)) // cells
+    """Block holding index position ``u`` on a grid of ``count`` blocks of ``cells`` cells
+    (a power of two: the floor division is a shift)."""
+    b = int(math.floor(u)) >> trailing_zeros(cells)
     if b < 0:
         return 0
     if b > count - 1:
