@@ -211,18 +211,25 @@ def _inside_end(k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in, t_out, k_las
 
 @helper_jit
 def _inside_run(k, t_check, k_last, t_in, t_out, gx1, gy1, gz1, ds, ax, ay, az, bx, by, bz,
-                flat, nx, nxy, shift, tstart, tinv, alpha_tab, color_tab, grey, threshold, acc):
+                flat, nx, nxy, shift, tstart, tinv, alpha_tab, color_tab, grey, threshold, acc,
+                inside_end):
     """The run of samples from ``k`` on that are :func:`_inside`, before ``t_check`` (the
     general loop's next skip check) and the cut segment ``k_last``: tent filter,
     classification from the tables, no shading, composited onto ``acc = (r, g, b, a)`` until
-    its opacity reaches ``threshold``. Returns ``(next k, acc)``: ``k`` itself where sample
-    ``k`` is not inside. The same arithmetic as the general loop, without a test per sample,
-    two samples a step: the second's loads start before the first is composited (it is
-    dropped if the first ends the ray)."""
+    its opacity reaches ``threshold``. Returns ``(next k, acc, inside_end)``: ``k`` itself
+    where sample ``k`` is not inside. The same arithmetic as the general loop, without a
+    test per sample, two samples a step: the second's loads start before the first is
+    composited (it is dropped if the first ends the ray).
+
+    ``inside_end`` is :func:`_inside_end` of this ray, or -1 before its first run: the
+    samples inside form one interval per ray, so its end, found once, serves every run
+    between the ray's skip checks."""
     if not _inside(k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in, t_out):
-        return k, acc
-    end = _before(t_check, ds, k, _inside_end(k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1,
-                                              t_in, t_out, k_last))
+        return k, acc, inside_end
+    if inside_end < 0:
+        inside_end = _inside_end(k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in, t_out,
+                                 k_last)
+    end = _before(t_check, ds, k, inside_end)
     j = k
     while j < end:
         alpha, i, w = _inside_sample(j, ds, ax, ay, az, bx, by, bz, flat, nx, nxy, shift,
@@ -242,7 +249,7 @@ def _inside_run(k, t_check, k_last, t_in, t_out, gx1, gy1, gz1, ds, ax, ay, az, 
                 acc = _over(acc, second, i2, w2, grey, color_tab)
                 if acc[3] >= threshold:
                     break
-    return j, acc
+    return j, acc, inside_end
 
 
 @jit(inline="always")
@@ -680,6 +687,7 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
             # (a sample that rounding puts in an empty block anyway adds exactly nothing).
             t_check = -math.inf if block > 0 else math.inf
             m_block = 1  # the step multiplier of the block before t_check, entered at t_enter
+            inside_end = -1  # where the ray's samples inside the volume end: not found yet
             t_enter = 0.0
             while True:
                 t = (k + 0.5) * ds
@@ -725,10 +733,10 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                 if (lighting is None and (filtering is None or fkind == TENT)
                         and m_block == 1 and k != k_first and k != k_last):
                     # A run of samples inside the volume, before the next skip check.
-                    j, acc = _inside_run(k, t_check, k_last, t_in, t_out, gx1, gy1, gz1, ds,
-                                         ax, ay, az, bx, by, bz, flat, nx, nxy, shift, tstart,
-                                         tinv, alpha_tab, color_tab, grey, threshold,
-                                         (acc_r, acc_g, acc_b, acc_a))
+                    j, acc, inside_end = _inside_run(
+                        k, t_check, k_last, t_in, t_out, gx1, gy1, gz1, ds, ax, ay, az, bx, by,
+                        bz, flat, nx, nxy, shift, tstart, tinv, alpha_tab, color_tab, grey,
+                        threshold, (acc_r, acc_g, acc_b, acc_a), inside_end)
                     if j > k:
                         acc_r, acc_g, acc_b, acc_a = acc
                         taken += j - k
