@@ -54,6 +54,7 @@ from vrlib._kernels._jit import readonly
 from vrlib._scheduling import on_threads
 from vrlib.footprint import RADIAL, footprint, running_integral, slanted
 from vrlib.gradients import SLAB, gradient_volumes, kernel_lighting, no_gradients
+from vrlib.holes import HoleTransfer
 from vrlib.image import Image, RenderStats
 from vrlib.prefilter import Tally, prepared, prepared_gradients
 from vrlib.value_bounds import reconstructed_range, subset_bounds
@@ -107,7 +108,8 @@ def drawable(volume, filt, transfer, mode, *, cull=True):
     """Nonzero where the splatter must draw.
 
     Direct mode: the voxels of nonzero density (evaluated a z-slab at a time). Sheet modes: the
-    nonzero samples, less (with ``cull``) every voxel whose neighbourhood makes it invisible:
+    nonzero samples (holes drawn as nothing), less (with ``cull``) every voxel whose
+    neighbourhood makes it invisible:
     a point within a voxel's support gathers samples within ``2 ceil(r) - 1`` voxels of it, so
     when the transfer function gives zero opacity to every sum of those samples weighted by
     the kernel, whichever of them are drawn (:func:`vrlib.value_bounds.subset_bounds`), the
@@ -131,10 +133,16 @@ def drawable(volume, filt, transfer, mode, *, cull=True):
            [ True, False]])
     """
     if mode != "direct":
+        samples = volume.data
+        if volume.holes is not None:
+            # A hole's splat is empty (vrlib.holes). Drawn with its stand-in value, a
+            # footprint's faint edge (a weight of 1e-20 or less) would bring that value back
+            # into the data's range.
+            samples = np.where(volume.holes, 0.0, samples)
         if not cull:
-            return volume.data  # nonzero values are the ones to draw
+            return samples  # nonzero values are the ones to draw
         keep = visible_neighbourhoods(volume, filt, transfer, mode)
-        return np.where(keep, volume.data, 0.0) if not keep.all() else volume.data
+        return np.where(keep, samples, 0.0) if not keep.all() else samples
     mask = np.empty(volume.shape, dtype=bool)
     for z in range(0, volume.shape[0], 16):
         mask[z:z + 16] = transfer.opacity_density(volume.data[z:z + 16]) > 0.0
@@ -295,6 +303,10 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
     # Slabs of the image-aligned mode tile the box's depth range.
     slab = slab_width * float(spacing.min())
     n_slabs = max(1, math.ceil((farthest - depth) / slab))
+    if mode != "direct" and isinstance(transfer, HoleTransfer):
+        # The sheets hold no hole (drawable draws holes as nothing), and a sheet's mean can
+        # pass the finite samples' range, where the wrapper would make it transparent.
+        transfer = transfer.inner
     # Values a sheet can hold lie within the reconstruction's bounds; widen them generously
     # (the tables are exact inside and clamp outside).
     lo, hi = reconstructed_range(volume, filt)
