@@ -15,8 +15,10 @@ value is blended in. Per method:
 How. A hole is stored as :func:`hole_value`, a finite value some 1e20 ranges above the data,
 so that any non-zero weight on it moves the reconstruction far outside the range the finite
 samples can reconstruct; :class:`HoleTransfer` wraps the transfer function to give such values
-no opacity. No renderer needs its own code for holes, and what is drawn never depends on
-the number stored.
+no opacity. Only splatting's sheet modes have code of their own: they draw a hole as nothing
+(:func:`vrlib.splat.drawable` zeroes its samples) and classify the sheets with the transfer
+function itself, since a sheet's mean may pass the finite samples' range. What is drawn
+never depends on the number stored.
 
 Not supported, with a clear error: prefiltered filters (their prefilter runs along whole
 lines, so one hole would reach every sample of its line), and shading or gradient opacity
