@@ -27,14 +27,13 @@ import numpy as np
 
 from vrlib import validate
 from vrlib._kernels.classified import composite_classified, shade_table
-from vrlib._kernels.shear import warp
-from vrlib._scheduling import thread_count
+from vrlib._scheduling import on_threads, thread_count
 from vrlib.arguments import check_transfer, framed_view
 from vrlib.colormapping import default_transfer
 from vrlib.filters import make_filter
 from vrlib.holes import with_holes
 from vrlib.image import Image, RenderStats
-from vrlib.shearwarp import intermediate_plane, warp_homography
+from vrlib.shearwarp import intermediate_plane, warp, warp_homography
 from vrlib.transfer import Phong
 from vrlib.view import principal_axis
 from vrlib.volume import Volume
@@ -285,10 +284,11 @@ class ClassifiedVolume:
             factor, highlight = self._shade_tables(view, shading)
             inter = np.zeros((height, width, 4))
             counts = np.zeros(height, np.int64)
-            composite_classified(*encoded, n_j, order, di, dj, length, self._emission, factor,
-                                 highlight, self._grey, shading is not None, threshold, BAND,
-                                 self._band_order(axis, dj, height), numba.get_num_threads(),
-                                 inter, counts)
+            arguments = (*encoded, n_j, order, di, dj, length, self._emission, factor,
+                         highlight, self._grey, shading is not None, threshold, BAND,
+                         self._band_order(axis, dj, height), np.zeros(1, np.int64), inter,
+                         counts)
+            on_threads(lambda i: composite_classified(*arguments), numba.get_num_threads())
             plane = volume.origin[axis] + kf * volume.spacing[axis]
             out = np.empty(view.shape + (4,))
             warp(inter, warp_homography(view, volume, axis, plane, (oi, oj)), out, self._grey)

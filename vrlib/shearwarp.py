@@ -18,11 +18,13 @@ from __future__ import annotations
 import math
 import time
 
+import numba
 import numpy as np
 
 from vrlib import validate
 from vrlib._kernels import shear as _kernel
 from vrlib._kernels._jit import readonly
+from vrlib._scheduling import on_threads
 from vrlib.gradients import kernel_lighting, no_gradients
 from vrlib.image import Image, RenderStats
 from vrlib.prefilter import Tally, prepared, prepared_gradients
@@ -32,7 +34,10 @@ from vrlib.value_bounds import lattice_sums, reconstructed_range
 from vrlib.view import principal_axis
 
 __all__ = ["render_shearwarp", "project_shearwarp", "transparent_bound", "intermediate_plane",
-           "warp_homography"]
+           "warp_homography", "warp"]
+
+#: Final-image rows per unit of the warp's parallel work.
+WARP_BAND = 16
 
 
 def transparent_bound(transfer, low, high, length, min_opacity):
@@ -126,6 +131,24 @@ def warp_homography(view, volume, axis, plane, offsets):
     return np.stack([g10 - g00, g01 - g00, g00], axis=1)
 
 
+def warp(inter, homography, out, grey=False):
+    """The 2-D warp into ``out`` (``(height, width, 4)``): each pixel ``(c, r)`` samples
+    ``inter`` bilinearly at ``(A / D, B / D)`` with ``(A, B, D) = homography @ (c, r, 1)``
+    (:func:`warp_homography`), on numba's thread count
+    (:func:`vrlib._kernels.shear.warp_rows`, which says what it skips).
+
+    Python threads run it (:func:`vrlib._scheduling.on_threads`), not a ``prange``: on one
+    thread the call runs in the caller's own thread, and the kernel compiles without numba's
+    parallel passes. On VolPack's example (256^2 pixels, ``bench_volpack_example.py``) the
+    warp took 0.33 ms a frame in a ``prange`` and takes 0.23 ms.
+    """
+    affine = homography[2, 0] == 0.0 and homography[2, 1] == 0.0 and homography[2, 2] == 1.0
+    seen = _kernel.seen_box(inter) if affine else np.zeros(4)
+    counter = np.zeros(1, np.int64)
+    on_threads(lambda i: _kernel.warp_rows(inter, homography, out, grey, seen, WARP_BAND,
+                                           counter), numba.get_num_threads())
+
+
 def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
                      empty_space_skipping, min_opacity=0.0):
     """Shear-warp rendering (Lacroute and Levoy 1994; arguments validated by
@@ -204,7 +227,7 @@ def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
     plane = volume.origin[axis] + kf * h[axis]
     out = np.empty(view.shape + (4,))
     grey = bool(np.all(tables[4] == 1.0))  # white emission: red, green and blue are equal
-    _kernel.warp(inter, warp_homography(view, volume, axis, plane, (oi, oj)), out, grey)
+    warp(inter, warp_homography(view, volume, axis, plane, (oi, oj)), out, grey)
     resampled = int(counts.sum())
     stats = RenderStats(samples=resampled, operations=resampled * (2 * ntaps**2 + 12)
                         + out.size * 8, bytes=int(volume.data.nbytes + inter.nbytes + out.nbytes),
@@ -248,7 +271,7 @@ def project_shearwarp(volume, view, *, filt, transfer, blend):
     inter = classify_projected(transfer, value, count > 0, volume.spacing)
     out = np.empty(view.shape + (4,))
     plane = volume.origin[axis] + kf * volume.spacing[axis]
-    _kernel.warp(inter, warp_homography(view, volume, axis, plane, (oi, oj)), out)
+    warp(inter, warp_homography(view, volume, axis, plane, (oi, oj)), out)
     taken = int(count.sum())
     stats = RenderStats(samples=taken, operations=taken * (2 * filt.taps**2 + 4) + out.size * 8,
                         bytes=int(volume.data.nbytes + inter.nbytes + out.nbytes),

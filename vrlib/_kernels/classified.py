@@ -21,21 +21,20 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import prange
 
-from vrlib._kernels._jit import at, helper_jit, jit, parallel_jit, put
+from vrlib._kernels._jit import at, borrowed, helper_jit, jit, put
 from vrlib._kernels.queue import take
 from vrlib._kernels.shading import half_vector, phong_terms
 
 
-@parallel_jit
+@jit
 def shade_table(normals, light, direction, ka, kd, ks, shininess, factor, highlight):
     """Phong's ``factor`` and ``highlight`` for every normal code (``normals``: one unit vector
     per code, zero for "no gradient"), lit from ``light`` and seen along ``direction``:
     shading as a table lookup per voxel, rebuilt once per frame (VolPack's lookup shader)."""
     hx, hy, hz = half_vector(light[0], light[1], light[2], direction[0], direction[1],
                              direction[2])
-    for n in prange(normals.shape[0]):
+    for n in range(normals.shape[0]):
         factor[n], highlight[n] = phong_terms(normals[n, 0], normals[n, 1], normals[n, 2],
                                               light[0], light[1], light[2], hx, hy, hz, ka, kd,
                                               ks, shininess)
@@ -111,10 +110,10 @@ def _pair(v, w_left, w_right, sigma, emission_code, normal_code, emission, facto
             + q1 * (at(emission, (e1, 2)) * at(factor, n1) + at(highlight, n1)))
 
 
-@parallel_jit
+@jit
 def composite_classified(run_ptr, run_start, run_end, run_voxel, sigma, emission_code,
                          normal_code, n_j, order, di, dj, length, emission, factor, highlight,
-                         grey, shaded, threshold, band_rows, bands, threads, inter, counts):
+                         grey, shaded, threshold, band_rows, bands, counter, inter, counts):
     """Composite the slices ``order`` (front to back) into ``inter[J, I] = (r, g, b, a)``.
 
     Slice ``k``'s sample for intermediate pixel ``(I, J)`` lies at column ``I + di[k]`` and row
@@ -126,39 +125,52 @@ def composite_classified(run_ptr, run_start, run_end, run_voxel, sigma, emission
     ``emission[e] * factor[n] + highlight[n]`` for its codes ``e`` and ``n`` (``grey``: white
     emission; unless ``shaded``, ``factor`` is 1 and ``highlight`` 0).
 
-    The image is cut into bands of ``band_rows`` rows; each of ``threads`` threads takes the
-    next band of ``bands`` (the heaviest first) from a shared queue
-    (:func:`vrlib._kernels.queue.take`) until none is left. A band walks the slices front to
-    back and, in each, its rows in order, so that it reads the encoding sequentially
-    (VolPack's object order). Each row is composited in a fixed order: the image does not
-    depend on the thread count. ``counts[J]`` gets the samples row ``J`` composited.
+    The image is cut into bands of ``band_rows`` rows. Several threads make the call at once
+    (:func:`vrlib._scheduling.on_threads`); each takes the next band of ``bands`` (the heaviest
+    first) from ``counter`` (:func:`vrlib._kernels.queue.take`) until none is left. A band
+    walks the slices front to back and, in each, its rows in order, so that it reads the
+    encoding sequentially (VolPack's object order). Each row is composited in a fixed order:
+    the image does not depend on the thread count. ``counts[J]`` gets the samples row ``J``
+    composited.
     """
-    counter = np.zeros(1, np.int64)
-    for _ in prange(threads):
-        while True:
-            it = take(counter)
-            if it >= bands.shape[0]:
-                break
-            _composite_band(run_ptr, run_start, run_end, run_voxel, sigma, emission_code,
-                            normal_code, n_j, order, di, dj, length, emission, factor,
-                            highlight, grey, shaded, threshold, band_rows, bands[it], inter,
-                            counts)
+    # A band's scratch: each row's skip links, its opaque pixels and its samples.
+    links = np.empty((band_rows, inter.shape[1] + 1), dtype=np.int64)
+    opaque = np.empty(band_rows, dtype=np.int64)
+    taken = np.empty(band_rows, dtype=np.int64)
+    while True:
+        it = take(counter)
+        if it >= bands.shape[0]:
+            break
+        _composite_band(run_ptr, run_start, run_end, run_voxel, sigma, emission_code,
+                        normal_code, n_j, order, di, dj, length, emission, factor, highlight,
+                        grey, shaded, threshold, band_rows, bands[it], inter, counts, links,
+                        opaque, taken)
 
 
 @helper_jit
 def _composite_band(run_ptr, run_start, run_end, run_voxel, sigma, emission_code, normal_code,
                     n_j, order, di, dj, length, emission, factor, highlight, grey, shaded,
-                    threshold, band_rows, band, inter, counts):
-    """Band ``band`` of :func:`composite_classified` (the same arguments)."""
+                    threshold, band_rows, band, inter, counts, links, opaque, taken):
+    """Band ``band`` of :func:`composite_classified` (the same arguments, and the band's
+    scratch ``links``, ``opaque`` and ``taken``, one row each per row of the band).
+
+    Every array is borrowed (:func:`vrlib._kernels._jit.borrowed`): the helpers inlined into
+    the loops over pixels then keep no reference counts (an atomic increment and decrement per
+    array, per call, that took half the frame's time on VolPack's example)."""
+    run_ptr, run_start, run_end = borrowed(run_ptr), borrowed(run_start), borrowed(run_end)
+    run_voxel, sigma, emission = borrowed(run_voxel), borrowed(sigma), borrowed(emission)
+    emission_code, normal_code = borrowed(emission_code), borrowed(normal_code)
+    order, di, dj = borrowed(order), borrowed(di), borrowed(dj)
+    factor, highlight, inter = borrowed(factor), borrowed(highlight), borrowed(inter)
+    links, opaque, taken = borrowed(links), borrowed(opaque), borrowed(taken)
     height, width = inter.shape[0], inter.shape[1]
     first_row = band * band_rows
     rows = min(band_rows, height - first_row)
-    links = np.empty((rows, width + 1), dtype=np.int64)
     for r in range(rows):
         for i in range(width + 1):
             links[r, i] = i
-    opaque = np.zeros(rows, dtype=np.int64)
-    taken = np.zeros(rows, dtype=np.int64)
+        opaque[r] = 0
+        taken[r] = 0
     for step in range(order.shape[0]):
         k = order[step]
         # The end slices stand for half a spacing (the volume's box ends there).

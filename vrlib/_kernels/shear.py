@@ -16,8 +16,9 @@ import math
 import numpy as np
 from numba import prange
 
-from vrlib._kernels._jit import at, helper_jit, jit, parallel_jit, put
+from vrlib._kernels._jit import at, borrowed, helper_jit, jit, parallel_jit, put
 from vrlib._kernels.filters import CUBIC, MAX_TAPS, TENT, weight
+from vrlib._kernels.queue import take
 from vrlib._kernels.sampling import clamp, cubic_weights, filter_taps
 from vrlib._kernels.shading import classify_by_gradient
 from vrlib._kernels.tables import entry, lookup
@@ -502,26 +503,33 @@ def _warp_pixel(inter, x, y, out, row, c, grey):
     transparent outside it, or where all four neighbours are (colours are premultiplied).
     ``grey``: red, green and blue are equal, and only red is interpolated."""
     n_j, n_i = inter.shape[0], inter.shape[1]
+    red = green = blue = alpha = 0.0
     if x >= 0.0 and y >= 0.0 and x <= n_i - 1 and y <= n_j - 1:
         i = min(int(x), n_i - 2)
         j = min(int(y), n_j - 2)
-        if not (at(inter, (j, i, 3)) == 0.0 and at(inter, (j, i + 1, 3)) == 0.0
-                and at(inter, (j + 1, i, 3)) == 0.0 and at(inter, (j + 1, i + 1, 3)) == 0.0):
+        a00, a01 = at(inter, (j, i, 3)), at(inter, (j, i + 1, 3))
+        a10, a11 = at(inter, (j + 1, i, 3)), at(inter, (j + 1, i + 1, 3))
+        if not (a00 == 0.0 and a01 == 0.0 and a10 == 0.0 and a11 == 0.0):
             tx = x - i
             ty = y - j
-            for ch in range(4):
-                if grey and (ch == 1 or ch == 2):
-                    continue
-                top = (1 - tx) * at(inter, (j, i, ch)) + tx * at(inter, (j, i + 1, ch))
-                bottom = ((1 - tx) * at(inter, (j + 1, i, ch))
-                          + tx * at(inter, (j + 1, i + 1, ch)))
-                put(out, (row, c, ch), min(max((1 - ty) * top + ty * bottom, 0.0), 1.0))
-            if grey:
-                put(out, (row, c, 1), at(out, (row, c, 0)))
-                put(out, (row, c, 2), at(out, (row, c, 0)))
-            return
-    for ch in range(4):
-        put(out, (row, c, ch), 0.0)
+            alpha = min(max((1 - ty) * ((1 - tx) * a00 + tx * a01)
+                            + ty * ((1 - tx) * a10 + tx * a11), 0.0), 1.0)
+            top = (1 - tx) * at(inter, (j, i, 0)) + tx * at(inter, (j, i + 1, 0))
+            bottom = (1 - tx) * at(inter, (j + 1, i, 0)) + tx * at(inter, (j + 1, i + 1, 0))
+            red = green = blue = min(max((1 - ty) * top + ty * bottom, 0.0), 1.0)
+            if not grey:
+                top = (1 - tx) * at(inter, (j, i, 1)) + tx * at(inter, (j, i + 1, 1))
+                bottom = ((1 - tx) * at(inter, (j + 1, i, 1))
+                          + tx * at(inter, (j + 1, i + 1, 1)))
+                green = min(max((1 - ty) * top + ty * bottom, 0.0), 1.0)
+                top = (1 - tx) * at(inter, (j, i, 2)) + tx * at(inter, (j, i + 1, 2))
+                bottom = ((1 - tx) * at(inter, (j + 1, i, 2))
+                          + tx * at(inter, (j + 1, i + 1, 2)))
+                blue = min(max((1 - ty) * top + ty * bottom, 0.0), 1.0)
+    put(out, (row, c, 0), red)
+    put(out, (row, c, 1), green)
+    put(out, (row, c, 2), blue)
+    put(out, (row, c, 3), alpha)
 
 
 @jit
@@ -567,52 +575,60 @@ def _columns_within(a, b, lo, hi, width):
     return max(int(math.floor(c0)) - 1, 0), min(int(math.ceil(c1)) + 2, width)
 
 
-@parallel_jit
-def _warp_affine(inter, m, out, grey, seen):
-    """The affine warp (:func:`warp`) over the columns that can meet the intermediate
-    image's non-transparent box ``seen = (i_lo, i_hi, j_lo, j_hi)``; the rest of each row is
-    transparent without a look, as every pixel there reads four transparent neighbours."""
+@jit
+def warp_rows(inter, m, out, grey, seen, band_rows, counter):
+    """The 2-D warp (:func:`vrlib.shearwarp.warp`): ``out[r, c]`` is ``inter`` sampled
+    bilinearly at ``(I, J) = (A, B) / D`` with ``(A, B, D) = m @ (c, r, 1)``, transparent
+    outside, or where ``D <= 0`` (the pixel's ray never meets the intermediate image's plane),
+    clipped to [0, 1]; ``grey`` images (red, green and blue equal) interpolate one colour
+    channel.
+
+    An affine ``m`` (orthographic views: ``D = 1``) takes no division and visits only the
+    columns that can meet the intermediate image's non-transparent box ``seen = (i_lo, i_hi,
+    j_lo, j_hi)`` (:func:`seen_box`); the rest of each row is transparent without a look, as
+    every pixel there reads four transparent neighbours. Several threads make the call at once
+    (:func:`vrlib._scheduling.on_threads`); each takes the next band of ``band_rows`` rows from
+    ``counter`` (:func:`vrlib._kernels.queue.take`) until none is left. Rows are independent:
+    the image does not depend on the thread count.
+    """
+    inter, m, out, seen = borrowed(inter), borrowed(m), borrowed(out), borrowed(seen)
     height, width = out.shape[0], out.shape[1]
-    for row in prange(height):
-        ax = m[0, 1] * row + m[0, 2]
-        ay = m[1, 1] * row + m[1, 2]
-        # A pixel reads columns int(x) and int(x) + 1: it can meet the box only for
-        # i_lo - 1 <= x < i_hi + 1 (and likewise for y).
-        x0, x1 = _columns_within(m[0, 0], ax, seen[0] - 1.0, seen[1] + 1.0, width)
-        y0, y1 = _columns_within(m[1, 0], ay, seen[2] - 1.0, seen[3] + 1.0, width)
-        first = max(x0, y0)
-        stop = max(min(x1, y1), first)
-        for c in range(first):
-            for ch in range(4):
-                put(out, (row, c, ch), 0.0)
-        for c in range(first, stop):
-            _warp_pixel(inter, m[0, 0] * c + ax, m[1, 0] * c + ay, out, row, c, grey)
-        for c in range(stop, width):
-            for ch in range(4):
-                put(out, (row, c, ch), 0.0)
+    affine = m[2, 0] == 0.0 and m[2, 1] == 0.0 and m[2, 2] == 1.0
+    while True:
+        first_row = take(counter) * band_rows
+        if first_row >= height:
+            break
+        for row in range(first_row, min(first_row + band_rows, height)):
+            if affine:
+                _warp_affine_row(inter, m, out, grey, seen, row, width)
+                continue
+            for c in range(width):
+                d = m[2, 0] * c + m[2, 1] * row + m[2, 2]
+                if d > 0.0:
+                    _warp_pixel(inter, (m[0, 0] * c + m[0, 1] * row + m[0, 2]) / d,
+                                (m[1, 0] * c + m[1, 1] * row + m[1, 2]) / d, out, row, c, grey)
+                else:
+                    for ch in range(4):
+                        put(out, (row, c, ch), 0.0)
 
 
-@parallel_jit
-def _warp_projective(inter, m, out, grey):
-    height, width = out.shape[0], out.shape[1]
-    for row in prange(height):
-        for c in range(width):
-            d = m[2, 0] * c + m[2, 1] * row + m[2, 2]
-            if d > 0.0:
-                _warp_pixel(inter, (m[0, 0] * c + m[0, 1] * row + m[0, 2]) / d,
-                            (m[1, 0] * c + m[1, 1] * row + m[1, 2]) / d, out, row, c, grey)
-            else:
-                for ch in range(4):
-                    out[row, c, ch] = 0.0
-
-
-def warp(inter, homography, out, grey=False):
-    """The 2-D warp: ``out[r, c]`` is ``inter`` sampled bilinearly at ``(I, J) = (A, B) / D``
-    with ``(A, B, D) = homography @ (c, r, 1)`` (transparent outside, or where ``D <= 0``: the
-    pixel's ray never meets the intermediate image's plane), clipped to [0, 1]. An affine
-    homography (orthographic views: ``D = 1``) takes no division; ``grey`` images (red, green
-    and blue equal) interpolate one colour channel."""
-    if homography[2, 0] == 0.0 and homography[2, 1] == 0.0 and homography[2, 2] == 1.0:
-        _warp_affine(inter, homography, out, grey, seen_box(inter))
-    else:
-        _warp_projective(inter, homography, out, grey)
+@jit(inline="always")
+def _warp_affine_row(inter, m, out, grey, seen, row, width):
+    """Row ``row`` of the affine warp (:func:`warp_rows`)."""
+    ax = m[0, 1] * row + m[0, 2]
+    ay = m[1, 1] * row + m[1, 2]
+    mx, my = m[0, 0], m[1, 0]  # in locals: the stores to ``out`` need not reload them
+    # A pixel reads columns int(x) and int(x) + 1: it can meet the box only for
+    # i_lo - 1 <= x < i_hi + 1 (and likewise for y).
+    x0, x1 = _columns_within(mx, ax, seen[0] - 1.0, seen[1] + 1.0, width)
+    y0, y1 = _columns_within(my, ay, seen[2] - 1.0, seen[3] + 1.0, width)
+    first = max(x0, y0)
+    stop = max(min(x1, y1), first)
+    for c in range(first):
+        for ch in range(4):
+            put(out, (row, c, ch), 0.0)
+    for c in range(first, stop):
+        _warp_pixel(inter, mx * c + ax, my * c + ay, out, row, c, grey)
+    for c in range(stop, width):
+        for ch in range(4):
+            put(out, (row, c, ch), 0.0)
