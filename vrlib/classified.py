@@ -282,6 +282,8 @@ class ClassifiedVolume:
             order = np.arange(n_k) if ascending else np.arange(n_k)[::-1].copy()
             length = float(volume.spacing[axis] / abs(view.forward[axis]))
             factor, highlight = self._shade_tables(view, shading)
+            if self._grey and shading is not None:
+                factor = factor + highlight  # a white voxel's grey: one table read
             inter = np.zeros((height, width, 4))
             counts = np.zeros(height, np.int64)
             arguments = (*encoded, n_j, order, di, dj, length, self._emission, factor,

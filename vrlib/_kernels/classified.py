@@ -85,16 +85,16 @@ def _pair(v, w_left, w_right, sigma, emission_code, normal_code, emission, facto
           grey, shaded):
     """Voxels ``v`` (weight ``w_left``) and ``v + 1`` (``w_right``) of one scanline: their
     weighted extinction and colours ``(extinction, r, g, b)``, each colour weighted by its
-    voxel's extinction (``grey``: white emission; unless ``shaded``, ``factor`` is 1 and
-    ``highlight`` 0)."""
+    voxel's extinction (``grey``: white emission, and a shaded voxel's grey is ``factor``
+    alone, the caller having added ``highlight`` to it; unless ``shaded``, ``factor`` is 1
+    and ``highlight`` 0)."""
     q0 = w_left * at(sigma, v)
     q1 = w_right * at(sigma, v + 1)
     if grey and not shaded:
         return q0 + q1, q0 + q1, 0.0, 0.0
     if grey:
         n0, n1 = at(normal_code, v), at(normal_code, v + 1)
-        lum = q0 * (at(factor, n0) + at(highlight, n0)) + q1 * (at(factor, n1) + at(highlight, n1))
-        return q0 + q1, lum, 0.0, 0.0
+        return q0 + q1, q0 * at(factor, n0) + q1 * at(factor, n1), 0.0, 0.0
     e0, e1 = at(emission_code, v), at(emission_code, v + 1)
     if not shaded:
         return (q0 + q1, q0 * at(emission, (e0, 0)) + q1 * at(emission, (e1, 0)),
@@ -123,7 +123,8 @@ def composite_classified(run_ptr, run_start, run_end, run_voxel, sigma, emission
     stored from ``run_voxel + 1`` on, between two transparent guard voxels (so that a sample at
     a run's edge reads a zero neighbour without a test). A voxel's colour is
     ``emission[e] * factor[n] + highlight[n]`` for its codes ``e`` and ``n`` (``grey``: white
-    emission; unless ``shaded``, ``factor`` is 1 and ``highlight`` 0).
+    emission, and ``factor`` holds ``factor + highlight``: one table read per voxel; unless
+    ``shaded``, ``factor`` is 1 and ``highlight`` 0).
 
     The image is cut into bands of ``band_rows`` rows. Several threads make the call at once
     (:func:`vrlib._scheduling.on_threads`); each takes the next band of ``bands`` (the heaviest
