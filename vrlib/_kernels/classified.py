@@ -174,6 +174,12 @@ def _composite_band(run_ptr, run_start, run_end, run_voxel, sigma, emission_code
         taken[r] = 0
     for step in range(order.shape[0]):
         k = order[step]
+        # The scanlines the band's rows read in this slice (rows first_row .. + rows - 1
+        # read r0 and r0 + 1 of row + dj[k]): none holds a run, nothing to do.
+        lo_line = min(max(math.floor(first_row + dj[k]), 0), n_j)
+        hi_line = min(max(math.floor(first_row + rows - 1 + dj[k]) + 2, 0), n_j)
+        if run_ptr[k * n_j + hi_line] == run_ptr[k * n_j + lo_line]:
+            continue
         # The end slices stand for half a spacing (the volume's box ends there).
         seg = 0.5 * length if step == 0 or step == order.shape[0] - 1 else length
         s_i = math.floor(di[k])
