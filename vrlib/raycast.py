@@ -336,7 +336,9 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
         skipping = None if skip[2] == 0 else True
         arguments = (*layout, bool(exact_ends), view.packed(), view.height, view.width, ds,
                      *filt.code, filt.radius, filt.taps, *tables, *lighting, *by_gradient,
-                     *skips, np.ones((1, 1, 1), np.int64) if multiplier is None else multiplier,
+                     *skips,
+                     readonly(vector(np.ones((1, 1, 1)) if multiplier is None else multiplier,
+                                     np.int64)),
                      *tiles, grey, filtering, lit, skipping)
         on_threads(lambda i: _kernel.raycast(*arguments, scratch[i]), threads)
     np.clip(out[..., 3], 0.0, 1.0, out=out[..., 3])

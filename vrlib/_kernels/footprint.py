@@ -56,7 +56,11 @@ def planar_at(extent, planar, j, ty, u):
 @jit
 def sort_prefix(values, count):
     """Sort ``values[:count]`` in place, ascending: insertion sort, for the few dozen cuts of
-    a line integral (numba's own sort costs two seconds of a first render's compile)."""
+    a line integral (numba's own sort costs two seconds of a first render's compile).
+
+    Callers pass ``count`` as an ``int64``: numba compiles a function once more for each
+    literal integer it is called with (a count that starts at a constant is one, for a
+    first pass of type inference)."""
     for n in range(1, count):
         item = values[n]
         m = n - 1
@@ -90,7 +94,7 @@ def partial_table(kind, p0, p1, p2, radius, spacing, basis, extent_u, extent_v, 
             u = -extent_u + 2.0 * extent_u * i / (nu - 1)
             base = (u * basis[0] + v * basis[3], u * basis[1] + v * basis[4],
                     u * basis[2] + v * basis[5])
-            count = 0
+            count = np.int64(0)  # not a literal 0: see sort_prefix
             for a in range(3):
                 if fwd[a] == 0.0:
                     continue
@@ -206,7 +210,7 @@ def slanted_integral(kind, p0, p1, p2, radius, bp, bq, mp, mq, nodes, weights, s
     n_knots = 4 * reach + 1
     cuts[0] = lo
     cuts[1] = hi
-    count = 2
+    count = np.int64(2)  # not a literal 2: see sort_prefix
     for n in range(n_knots):
         knot = (n - 2 * reach) * 0.5
         if lo < knot < hi:

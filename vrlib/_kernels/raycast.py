@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import literally
 
 from vrlib._kernels._jit import borrowed, helper_jit, jit, trailing_zeros
@@ -44,7 +45,7 @@ from vrlib._kernels.sampling import (
     trilinear_inside,
 )
 from vrlib._kernels.shading import classify_by_gradient, modulate_by_gradient
-from vrlib._kernels.tables import entry, entry_channel, interpolate, interpolate_channel, lookup
+from vrlib._kernels.tables import entry, entry_channel, interpolate, interpolate_rgb, lookup
 
 
 @helper_jit
@@ -72,7 +73,7 @@ def _block_bound(bound, cells, ux, uy, uz):
 
 
 @helper_jit
-def _exit(ax, ay, az, bx, by, bz, cells, counts, ux, uy, uz, reach=1):
+def _exit(ax, ay, az, bx, by, bz, cells, counts, ux, uy, uz, reach):
     """Ray parameter where the ray (index position ``a + t b``) leaves the cube of
     ``2 reach - 1`` blocks a side centred on the block that holds ``(ux, uy, uz)``, on a grid
     of ``cells``-cell blocks (``counts`` blocks per axis, z y x): that block itself for
@@ -296,7 +297,10 @@ def _skip(k, ux, uy, uz, ax, ay, az, bx, by, bz, ds, by_front, empty, clearance,
     reach = _block_bound(clearance, block, ux, uy, uz)
     if reach <= 0:  # a block that is not empty
         if budget > 0.0 or blockwise:
-            t_exit = _exit(ax, ay, az, bx, by, bz, block, fine_counts, ux, uy, uz)
+            # The block itself (an int64 1, not a literal: numba would compile _exit once
+            # more for it).
+            t_exit = _exit(ax, ay, az, bx, by, bz, block, fine_counts, ux, uy, uz,
+                           np.int64(1))
         else:
             # Every block within the clearance is not empty: sample on to the cube's face.
             t_exit = _exit(ax, ay, az, bx, by, bz, block, fine_counts, ux, uy, uz, -reach)
@@ -466,13 +470,10 @@ def _step_segment(front, back, length, start, inv, density, emission, grey):
     if grey or not alpha > 0.0:
         return alpha, alpha, alpha, alpha
     behind = (1.0 - half_a) * half_b
-    return (alpha,
-            half_a * interpolate_channel(emission, start, inv, front, 0)
-            + behind * interpolate_channel(emission, start, inv, back, 0),
-            half_a * interpolate_channel(emission, start, inv, front, 1)
-            + behind * interpolate_channel(emission, start, inv, back, 1),
-            half_a * interpolate_channel(emission, start, inv, front, 2)
-            + behind * interpolate_channel(emission, start, inv, back, 2))
+    front_r, front_g, front_b = interpolate_rgb(emission, start, inv, front)
+    back_r, back_g, back_b = interpolate_rgb(emission, start, inv, back)
+    return (alpha, half_a * front_r + behind * back_r, half_a * front_g + behind * back_g,
+            half_a * front_b + behind * back_b)
 
 
 @jit(inline="always")
@@ -687,7 +688,9 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
             # (a sample that rounding puts in an empty block anyway adds exactly nothing).
             t_check = -math.inf if block > 0 else math.inf
             m_block = 1  # the step multiplier of the block before t_check, entered at t_enter
-            inside_end = -1  # where the ray's samples inside the volume end: not found yet
+            # Where the ray's samples inside the volume end: not found yet (an int64, not
+            # the literal -1, which would compile _inside_run a second time: 0.45 s).
+            inside_end = np.int64(-1)
             t_enter = 0.0
             while True:
                 t = (k + 0.5) * ds

@@ -49,7 +49,13 @@ from vrlib._kernels.footprint import (
 )
 from vrlib._kernels.queue import take
 from vrlib._kernels.shading import classify_by_gradient
-from vrlib._kernels.tables import interpolate, interpolate_channel, lookup, piecewise_linear
+from vrlib._kernels.tables import (
+    interpolate,
+    interpolate_channel,
+    interpolate_rgb,
+    lookup,
+    piecewise_linear,
+)
 
 SHEET, DIRECT, IMAGE = 0, 1, 2
 
@@ -584,9 +590,7 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
                             eg = voxel_colour[kc, jc, ic, 1]
                             eb = voxel_colour[kc, jc, ic, 2]
                         elif mode == DIRECT:
-                            er = interpolate_channel(emit_tab, vstart, vinv, f, 0)
-                            eg = interpolate_channel(emit_tab, vstart, vinv, f, 1)
-                            eb = interpolate_channel(emit_tab, vstart, vinv, f, 2)
+                            er, eg, eb = interpolate_rgb(emit_tab, vstart, vinv, f)
                         for r in range(top, bottom + 1):
                             if perspective or clipped:
                                 for c in range(left, right + 1):
@@ -601,7 +605,7 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
                                         o, d = pixel_ray(camera, height, width, r, c)
                                         if fkind != RADIAL:
                                             fp = _slanted(slanted, slanted_reach, slanted_slope,
-                                                          fcode[0], fcode[1], fcode[2],
+                                                          int(fcode[0]), fcode[1], fcode[2],
                                                           fcode[3], radius, nodes,
                                                           weights, cuts, o, d, x, y, z,
                                                           spacing, axis, pa, qa, lo, hi)

@@ -50,6 +50,15 @@ def interpolate_channel(tab, start, inv, value, channel):
 
 
 @jit
+def interpolate_rgb(tab, start, inv, value):
+    """Columns 0, 1 and 2 of the 2-D table ``tab`` at ``value``, as :func:`interpolate`: one
+    compiled function (:func:`interpolate_channel` called with the constants 0, 1 and 2 is
+    compiled once for each, as numba specialises a call on a literal integer)."""
+    i, w = lookup((value - start) * inv, tab.shape[0])
+    return entry_channel(tab, i, w, 0), entry_channel(tab, i, w, 1), entry_channel(tab, i, w, 2)
+
+
+@jit
 def piecewise_linear(xs, ys, x):
     """The piecewise-linear function through points ``(xs, ys)`` (``xs`` increasing) at ``x``,
     constant beyond the ends (as ``numpy.interp``); a short table, searched in order."""
