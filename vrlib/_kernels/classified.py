@@ -262,14 +262,15 @@ def _composite_band(run_ptr, run_start, run_end, run_voxel, sigma, emission_code
                         # back (eqs 1.7-1.8).
                         alpha = _opacity(ext * seg)
                         scale = alpha / ext
-                        cr *= scale
-                        cg = cr if grey else cg * scale
-                        cb = cr if grey else cb * scale
                         acc = at(inter, (row, pixel, 3))
                         remaining = 1.0 - acc
-                        put(inter, (row, pixel, 0), at(inter, (row, pixel, 0)) + remaining * cr)
-                        put(inter, (row, pixel, 1), at(inter, (row, pixel, 1)) + remaining * cg)
-                        put(inter, (row, pixel, 2), at(inter, (row, pixel, 2)) + remaining * cb)
+                        put(inter, (row, pixel, 0),
+                            at(inter, (row, pixel, 0)) + remaining * (cr * scale))
+                        if not grey:  # grey: red alone (the warp copies it)
+                            put(inter, (row, pixel, 1),
+                                at(inter, (row, pixel, 1)) + remaining * (cg * scale))
+                            put(inter, (row, pixel, 2),
+                                at(inter, (row, pixel, 2)) + remaining * (cb * scale))
                         acc += remaining * alpha
                         put(inter, (row, pixel, 3), acc)
                         if acc >= threshold:
