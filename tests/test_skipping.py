@@ -89,13 +89,16 @@ def test_clearance_is_the_distance_to_the_other_kind(seed):
     ("raycast", {"classification": "preintegrated"}),
     ("raycast", {"skip_budget": 1e-3}),
     ("splat", {}),
+    ("shear3", {}),
+    ("shearwarp", {}),
 ])
 def test_a_transfer_function_changed_in_place_is_not_served_from_a_cache(method, options):
     """What renders keep between calls (a volume's skip grid, a transfer function's
-    pre-integrated tables, splatting's culled voxels) is kept under the transfer function's
-    settings (``cache_key``). A table changed in place after a render, so that other blocks
-    show, must render as a new transfer function with those settings does: a grid or table
-    kept under the old settings would leave the newly visible blobs' edges out."""
+    segment and pre-integrated tables, splatting's culled voxels) is kept under the transfer
+    function's settings (``cache_key``). A table changed in place after a render, so that
+    other blocks show, must render as a new transfer function with those settings does: a
+    grid or table kept under the old settings would leave the newly visible blobs' edges
+    out."""
     vol = data_gen.make_field("random-blobs", count=3, seed=1).sample(24)
     view = View.orbit(size=24, azimuth=20.0, elevation=10.0)
     tf = LookupTransfer([0.0, 0.0, 4.0, 4.0], value_range=vol.value_range)

@@ -235,9 +235,31 @@ class TransferFunction:
         >>> start, inv, alpha.round(4).tolist()
         (0.0, 4.0, [0.0, 0.2212, 0.3935, 0.5276, 0.6321])
         """
-        start, inverse_step, density, emit = self.value_table(low, high, entries=entries)
+        # Kept with the transfer function, as the pre-integrated tables are (shared: the
+        # kernels only read them): a turntable renders every frame at one step, and a render
+        # to a tolerance tries a few steps on one value table.
+        return self._kept(("segment", length, float(low), float(high), entries),
+                          lambda: self._segment_table(length, low, high, entries))
+
+    def _segment_table(self, length, low, high, entries):
+        start, inverse_step, density, emit = self._kept(
+            ("values", float(low), float(high), entries),
+            lambda: self.value_table(low, high, entries=entries))
         alpha = -np.expm1(-density * length)
         return start, inverse_step, alpha, emit * alpha[:, None], emit
+
+    def _kept(self, key, build):
+        """``build()``, kept with this transfer function under its settings
+        (:meth:`cache_key`) and ``key``; the last :data:`_TABLES_KEPT` are kept."""
+        key = (self.cache_key(), *key)
+        kept = _TABLES.setdefault(self, OrderedDict())
+        if key in kept:
+            kept.move_to_end(key)
+        else:
+            kept[key] = build()
+            while len(kept) > _TABLES_KEPT:
+                kept.popitem(last=False)
+        return kept[key]
 
     def preintegrated_table(self, length, low, high, *, entries=256, refine=4,
                             profile="linear"):
@@ -285,15 +307,9 @@ class TransferFunction:
             high = low + 1.0  # one value: any span will do
         # The last few tables are kept with the transfer function: a turntable renders many
         # frames with one step, and a render to a tolerance tries a few steps each time.
-        key = (self.cache_key(), length, low, high, entries, refine, profile)
-        kept = _TABLES.setdefault(self, OrderedDict())
-        if key in kept:
-            kept.move_to_end(key)
-        else:
-            kept[key] = self._preintegrate(length, low, high, entries, refine, profile)
-            while len(kept) > _TABLES_KEPT:
-                kept.popitem(last=False)
-        return kept[key]
+        return self._kept(("preintegrated", length, low, high, entries, refine, profile),
+                          lambda: self._preintegrate(length, low, high, entries, refine,
+                                                     profile))
 
     def _preintegrate(self, length, low, high, entries, refine, profile):
         from vrlib._kernels.preintegration import cumulative_at, mean_emission_table
@@ -342,8 +358,8 @@ class TransferFunction:
         return start, inverse_step, self.opacity_density(values), self.emission(values)
 
 
-_TABLES = weakref.WeakKeyDictionary()  # pre-integrated tables kept per transfer function
-_TABLES_KEPT = 8
+_TABLES = weakref.WeakKeyDictionary()  # tables kept per transfer function (_kept)
+_TABLES_KEPT = 24
 
 
 class PreintegratedTable(NamedTuple):
