@@ -111,6 +111,36 @@ def test_a_transfer_function_changed_in_place_is_not_served_from_a_cache(method,
     np.testing.assert_array_equal(changed.rgba, fresh.rgba)
 
 
+class _ComparedGlow(Glow):
+    """A user's subclass that defines ``==`` and so, in Python, no hash: no weak key."""
+
+    def __eq__(self, other):
+        return isinstance(other, _ComparedGlow) and other.scale == self.scale
+
+
+class _UnpicklableGlow(Glow):
+    """A user's subclass holding what pickle refuses: no settings key."""
+
+    def __init__(self, scale):
+        super().__init__(scale)
+        self.note = lambda: None
+
+
+@pytest.mark.parametrize("cls", [_ComparedGlow, _UnpicklableGlow])
+@pytest.mark.parametrize("classification", ["point", "preintegrated"])
+def test_a_transfer_function_that_cannot_be_kept_under_renders_as_its_settings(cls,
+                                                                            classification):
+    """Tables are kept with a transfer function under its settings, in a weak dictionary
+    keyed by the object; a subclass that cannot be hashed or pickled keeps nothing and
+    renders, twice, as the built-in function with its settings."""
+    vol = data_gen.make_field("random-blobs", count=3, seed=1).sample(16)
+    view = View.orbit(size=12, azimuth=20.0)
+    want = render(vol, view, transfer=Glow(3.0), classification=classification)
+    for _ in range(2):
+        got = render(vol, view, transfer=cls(3.0), classification=classification)
+        np.testing.assert_array_equal(got.rgba, want.rgba)
+
+
 def test_the_skip_grid_is_kept_per_filter_and_transfer_function():
     """One grid per (filter, transfer function settings), built once: equal settings in a
     new object find it, another filter or scale builds its own, and the grid is read-only

@@ -250,9 +250,13 @@ class TransferFunction:
 
     def _kept(self, key, build):
         """``build()``, kept with this transfer function under its settings
-        (:meth:`cache_key`) and ``key``; the last :data:`_TABLES_KEPT` are kept."""
+        (:meth:`cache_key`) and ``key``; the last :data:`_TABLES_KEPT` are kept. A subclass
+        whose objects cannot be weakly referenced or hashed keeps nothing."""
         key = (self.cache_key(), *key)
-        kept = _TABLES.setdefault(self, OrderedDict())
+        try:
+            kept = _TABLES.setdefault(self, OrderedDict())
+        except TypeError:
+            return build()
         if key in kept:
             kept.move_to_end(key)
         else:
