@@ -219,7 +219,8 @@ class ClassifiedVolume:
                 self._encodings.items()}
 
     def _shade_tables(self, view, shading):
-        """Per normal code, the multiplier of the emission and the highlight added to it."""
+        """Per normal code, the multiplier of the emission and the highlight added to it (for
+        white emission the multiplier holds their sum: a voxel's grey is one table read)."""
         count = NORMAL_BINS**2 + 1
         if shading is None:
             return np.ones(count), np.zeros(count)
@@ -227,6 +228,8 @@ class ClassifiedVolume:
         factor, highlight = np.empty(count), np.empty(count)
         shade_table(_normals(), np.asarray(light, np.float64), view.forward, shading.ambient,
                     shading.diffuse, shading.specular, shading.shininess, factor, highlight)
+        if self._grey:
+            factor += highlight
         return factor, highlight
 
     def _band_order(self, axis, dj, height):
@@ -282,8 +285,6 @@ class ClassifiedVolume:
             order = np.arange(n_k) if ascending else np.arange(n_k)[::-1].copy()
             length = float(volume.spacing[axis] / abs(view.forward[axis]))
             factor, highlight = self._shade_tables(view, shading)
-            if self._grey and shading is not None:
-                factor = factor + highlight  # a white voxel's grey: one table read
             inter = np.zeros((height, width, 4))
             counts = np.zeros(height, np.int64)
             arguments = (*encoded, n_j, order, di, dj, length, self._emission, factor,

@@ -512,24 +512,29 @@ def _warp_pixel(inter, x, y, out, row, c, grey):
         if not (a00 == 0.0 and a01 == 0.0 and a10 == 0.0 and a11 == 0.0):
             tx = x - i
             ty = y - j
-            alpha = min(max((1 - ty) * ((1 - tx) * a00 + tx * a01)
-                            + ty * ((1 - tx) * a10 + tx * a11), 0.0), 1.0)
-            top = (1 - tx) * at(inter, (j, i, 0)) + tx * at(inter, (j, i + 1, 0))
-            bottom = (1 - tx) * at(inter, (j + 1, i, 0)) + tx * at(inter, (j + 1, i + 1, 0))
-            red = green = blue = min(max((1 - ty) * top + ty * bottom, 0.0), 1.0)
+            alpha = _clipped((1 - ty) * ((1 - tx) * a00 + tx * a01)
+                             + ty * ((1 - tx) * a10 + tx * a11))
+            red = green = blue = _bilinear(inter, j, i, 0, tx, ty)
             if not grey:
-                top = (1 - tx) * at(inter, (j, i, 1)) + tx * at(inter, (j, i + 1, 1))
-                bottom = ((1 - tx) * at(inter, (j + 1, i, 1))
-                          + tx * at(inter, (j + 1, i + 1, 1)))
-                green = min(max((1 - ty) * top + ty * bottom, 0.0), 1.0)
-                top = (1 - tx) * at(inter, (j, i, 2)) + tx * at(inter, (j, i + 1, 2))
-                bottom = ((1 - tx) * at(inter, (j + 1, i, 2))
-                          + tx * at(inter, (j + 1, i + 1, 2)))
-                blue = min(max((1 - ty) * top + ty * bottom, 0.0), 1.0)
+                green = _bilinear(inter, j, i, 1, tx, ty)
+                blue = _bilinear(inter, j, i, 2, tx, ty)
     put(out, (row, c, 0), red)
     put(out, (row, c, 1), green)
     put(out, (row, c, 2), blue)
     put(out, (row, c, 3), alpha)
+
+
+@jit(inline="always")
+def _bilinear(inter, j, i, ch, tx, ty):
+    """Channel ``ch`` of ``inter`` at ``(i + tx, j + ty)``, clipped to [0, 1]."""
+    top = (1 - tx) * at(inter, (j, i, ch)) + tx * at(inter, (j, i + 1, ch))
+    bottom = (1 - tx) * at(inter, (j + 1, i, ch)) + tx * at(inter, (j + 1, i + 1, ch))
+    return _clipped((1 - ty) * top + ty * bottom)
+
+
+@jit(inline="always")
+def _clipped(value):
+    return min(max(value, 0.0), 1.0)
 
 
 @jit
