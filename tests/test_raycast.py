@@ -306,11 +306,12 @@ def test_early_termination_stays_within_its_bound():
 @pytest.mark.parametrize("brick", [False, True], ids=["whole", "brick"])
 def test_runs_inside_the_volume_equal_the_general_loop(ends, projection, brick):
     """The common case (tent filter, grey, nothing to skip) samples its runs of cells inside
-    the volume without a test per sample, two samples a step, each run as long as the ray
-    stays inside: its image and sample count equal, bit for bit, those of the same render
-    whose runs are cut at every block face by skip checks (a skip grid whose blocks are all
-    visible), over rays that stop by early termination inside a run, rays cut by the
-    volume's faces, a perspective eye and a brick's own box. (Both take the runs; the naive
+    the volume without a test per sample, eight rays' runs at once in vector form, each run
+    as long as the ray stays inside: its image and sample count equal, bit for bit, those of
+    the same render whose runs are cut at every block face by skip checks (a skip grid whose
+    blocks are all visible: lanes that leave and rejoin the packet), over rays that stop by
+    early termination inside a run, rays cut by the volume's faces, a perspective eye and a
+    brick's own box. (Both take the runs; the naive
     twins check the runs' arithmetic against a loop that samples each segment on its own:
     a run that ends one sample late fails five of ``test_exact_segment_ends_match_naive_twin``
     and none here.)"""

@@ -340,6 +340,8 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
                      readonly(vector(np.ones((1, 1, 1)) if multiplier is None else multiplier,
                                      np.int64)),
                      *tiles, grey, filtering, lit, skipping)
-        on_threads(lambda i: _kernel.raycast(*arguments, scratch[i]), threads)
+        lanes = _kernel.lanes(threads)
+        on_threads(lambda i: _kernel.raycast(*arguments, scratch[i], *(a[i] for a in lanes)),
+                   threads)
     np.clip(out[..., 3], 0.0, 1.0, out=out[..., 3])
     return out, int(samples.sum())

@@ -20,8 +20,8 @@ Classification reads a per-render table of segment opacity and colour
 
 A sample's position as computed is monotone in ``k``, so the samples whose cells lie inside
 the volume form one run per ray (or per stretch between skip checks). With the tent filter
-and no shading, :func:`_inside_run` takes that run with no test per sample and the same
-arithmetic, bit for bit (docs/kernel.md).
+and no shading, eight rays' runs are taken together in vector form, with no test per sample
+and the same arithmetic, bit for bit (:mod:`vrlib._kernels.packets`, docs/kernel.md).
 """
 
 from __future__ import annotations
@@ -34,6 +34,23 @@ from numba import literally
 from vrlib._kernels._jit import borrowed, helper_jit, jit, trailing_zeros
 from vrlib._kernels.camera import pixel_ray, ray_box
 from vrlib._kernels.filters import CUBIC, TENT
+from vrlib._kernels.packets import (
+    ALPHA,
+    AX,
+    AY,
+    AZ,
+    BLUE,
+    BX,
+    BY,
+    BZ,
+    END,
+    GREEN,
+    LANES,
+    RAY_ROWS,
+    RED,
+    K,
+    inside_runs,
+)
 from vrlib._kernels.preintegration import bilinear_channel, psi_at
 from vrlib._kernels.queue import take
 from vrlib._kernels.sampling import (
@@ -42,10 +59,29 @@ from vrlib._kernels.sampling import (
     separable4,
     tricubic,
     trilinear,
-    trilinear_inside,
 )
 from vrlib._kernels.shading import classify_by_gradient, modulate_by_gradient
 from vrlib._kernels.tables import entry, entry_channel, interpolate, interpolate_rgb, lookup
+
+# The rest of a lane's ray state in the kernel (beside vrlib._kernels.packets' rays and
+# steps): rows of a float and an integer array, one column per lane; and its status.
+_D0, _D1, _D2, _T_IN, _T_OUT, _T_FIRST, _T_LAST, _SPENT, _T_CHECK, _T_ENTER = range(10)
+_STATE_ROWS = 10
+_ROW, _COL, _K, _K_FIRST, _K_LAST, _M_BLOCK, _INSIDE_END = range(7)
+_STEP_ROWS = 7
+DONE, MARCH, RUN = 0, 1, 2
+
+
+
+def lanes(threads):
+    """Each thread's lanes for :func:`raycast` (``[thread]`` of each array): its rays and
+    packet state (:mod:`vrlib._kernels.packets`), the rest of each ray's state, and whether
+    it is marching, waiting for the packet or done. Allocated by the caller, so that the
+    kernel compiles no allocation (``np.zeros`` cost a first render 0.4 s)."""
+    return (np.zeros((threads, RAY_ROWS, LANES)), np.zeros((threads, 2, LANES), np.int64),
+            np.zeros((threads, _STATE_ROWS, LANES)),
+            np.zeros((threads, _STEP_ROWS, LANES), np.int64),
+            np.zeros((threads, LANES), np.int64))
 
 
 @helper_jit
@@ -141,38 +177,6 @@ def _inside(k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in, t_out):
             and 0.0 <= uz < gz1)
 
 
-@helper_jit
-def _inside_sample(k, ds, ax, ay, az, bx, by, bz, flat, nx, nxy, shift, tstart, tinv,
-                   alpha_tab):
-    """Sample ``k``, one that is :func:`_inside`: the tent filter's value there (no test of
-    the cell) and its segment opacity from the table, ``(alpha, i, w)`` with the table's row
-    ``i + w``."""
-    t = (k + 0.5) * ds
-    ux = ax + t * bx
-    uy = ay + t * by
-    uz = az + t * bz
-    ix, iy, iz = int(ux), int(uy), int(uz)  # floor: u >= 0
-    value = trilinear_inside(flat, nx, nxy, shift, ix, iy, iz, ux - ix, uy - iy, uz - iz)
-    i, w = lookup((value - tstart) * tinv, alpha_tab.shape[0])
-    return entry(alpha_tab, i, w), i, w
-
-
-@jit(inline="always")
-def _over(acc, alpha, i, w, grey, color_tab):
-    """Front-to-back over (eqs 1.7-1.8) of a segment of opacity ``alpha`` and colour from
-    row ``i + w`` of ``color_tab`` (``grey``: the colour is the opacity, and ``acc``'s
-    red, green and blue are equal), onto ``acc = (r, g, b, a)``. Inlined: compiled on its
-    own it cost the first render about 0.25 s, twice what typing it at its two calls does."""
-    r, g, b, a = acc
-    remaining = 1.0 - a
-    if grey:
-        r += remaining * alpha
-        return r, r, r, a + remaining * alpha
-    return (r + remaining * entry_channel(color_tab, i, w, 0),
-            g + remaining * entry_channel(color_tab, i, w, 1),
-            b + remaining * entry_channel(color_tab, i, w, 2), a + remaining * alpha)
-
-
 @jit(inline="always")
 def _before(t_check, ds, k, end):
     """``end`` cut to the first sample after ``k`` at or past ``t_check`` (the general
@@ -208,49 +212,6 @@ def _inside_end(k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in, t_out, k_las
                                                    gz1, t_in, t_out):
         end += 1
     return end
-
-
-@helper_jit
-def _inside_run(k, t_check, k_last, t_in, t_out, gx1, gy1, gz1, ds, ax, ay, az, bx, by, bz,
-                flat, nx, nxy, shift, tstart, tinv, alpha_tab, color_tab, grey, threshold, acc,
-                inside_end):
-    """The run of samples from ``k`` on that are :func:`_inside`, before ``t_check`` (the
-    general loop's next skip check) and the cut segment ``k_last``: tent filter,
-    classification from the tables, no shading, composited onto ``acc = (r, g, b, a)`` until
-    its opacity reaches ``threshold``. Returns ``(next k, acc, inside_end)``: ``k`` itself
-    where sample ``k`` is not inside. The same arithmetic as the general loop, without a
-    test per sample, two samples a step: the second's loads start before the first is
-    composited (it is dropped if the first ends the ray).
-
-    ``inside_end`` is :func:`_inside_end` of this ray, or -1 before its first run: the
-    samples inside form one interval per ray, so its end, found once, serves every run
-    between the ray's skip checks."""
-    if not _inside(k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in, t_out):
-        return k, acc, inside_end
-    if inside_end < 0:
-        inside_end = _inside_end(k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in, t_out,
-                                 k_last)
-    end = _before(t_check, ds, k, inside_end)
-    j = k
-    while j < end:
-        alpha, i, w = _inside_sample(j, ds, ax, ay, az, bx, by, bz, flat, nx, nxy, shift,
-                                     tstart, tinv, alpha_tab)
-        second, i2, w2 = 0.0, 0, 0.0
-        if j + 1 < end:
-            second, i2, w2 = _inside_sample(j + 1, ds, ax, ay, az, bx, by, bz, flat, nx, nxy,
-                                            shift, tstart, tinv, alpha_tab)
-        j += 1
-        if alpha > 0.0:
-            acc = _over(acc, alpha, i, w, grey, color_tab)
-            if acc[3] >= threshold:
-                break
-        if j < end:
-            j += 1
-            if second > 0.0:
-                acc = _over(acc, second, i2, w2, grey, color_tab)
-                if acc[3] >= threshold:
-                    break
-    return j, acc, inside_end
 
 
 @jit(inline="always")
@@ -607,7 +568,8 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
             tstart, tinv, alpha_tab, color_tab, emit_tab,
             shade, ka, kd, ks, shininess, light, headlight, ramp_x, ramp_y, by_gradient,
             threshold, empty, clearance, block, mask, bound, budget, multiplier, tile_h, tile_w,
-            order, counter, out, samples, grey, filtering, lighting, skipping, scratch):
+            order, counter, out, samples, grey, filtering, lighting, skipping, scratch, rays,
+            steps, ray_state, ray_steps, status):
     """Render ``out[row, col] = (r, g, b, a)`` premultiplied (``out`` comes transparent: a
     pixel whose ray meets nothing, and a tile left out of ``order``, stay so); count samples
     per tile.
@@ -646,7 +608,15 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
     None argument before it types the function, so such a kernel compiles in a fraction of
     the time (a first render's wait); ``True`` compiles that path. ``scratch``
     (6 x ``MAX_TAPS``, this call's own) holds the filter's weights and their derivatives
-    along x, y and z.
+    along x, y and z; ``rays, steps, ray_state, ray_steps, status`` are this call's lanes
+    (:func:`lanes`).
+
+    Rays go in groups of ``LANES`` pixels of a tile row. Each ray is marched alone (the
+    checked samples: cut segments, borders, skips, other filters, shading) up to where its
+    samples run inside the volume (with the tent filter and no shading); the group's runs
+    are then taken together as one packet in vector form
+    (:func:`vrlib._kernels.packets.inside_runs`: lane by lane the scalar loop's arithmetic,
+    so the image is the same bit for bit), and the rays march on until all have ended.
     """
     data, offset, gshape, origin, camera, light, ramp_x, ramp_y, empty, clearance, bound, \
         flat, inv, fine_counts, wx, wy, wz, dx, dy, dz = _loop_views(
@@ -671,138 +641,206 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
         row0 = (tile_id // tiles_across) * tile_h
         col0 = (tile_id % tiles_across) * tile_w
         taken = 0
-        for p in range(tile_h * tile_w):
-            r = row0 + p // tile_w
-            c = col0 + p % tile_w
-            hit, d, t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, t_first, t_last = \
-                _pixel_start(r, c, camera, height, width, mask, box_lo, box_hi, vol_lo,
-                             vol_hi, exact, origin, inv, ds)
-            if not hit:
-                continue
-            acc_r = 0.0
-            acc_g = 0.0
-            acc_b = 0.0
-            acc_a = 0.0
-            spent = 0.0  # the budget's share this ray has used
-            # Samples before t_check lie in a block already found not empty: no check needed
-            # (a sample that rounding puts in an empty block anyway adds exactly nothing).
-            t_check = -math.inf if block > 0 else math.inf
-            m_block = 1  # the step multiplier of the block before t_check, entered at t_enter
-            # Where the ray's samples inside the volume end: not found yet (an int64, not
-            # the literal -1, which would compile _inside_run a second time: 0.45 s).
-            inside_end = np.int64(-1)
-            t_enter = 0.0
+        for p0 in range(0, tile_h * tile_w, LANES):
+            # A group of LANES pixels. Each lane's ray is marched alone up to where its
+            # samples run inside the volume; the lanes' runs are then taken together, as one
+            # packet (vrlib._kernels.packets.inside_runs, the same arithmetic lane by lane),
+            # and the lanes march on, until every ray has ended.
+            for lane in range(LANES):
+                status[lane] = DONE
+                steps[K, lane] = 0
+                steps[END, lane] = 0  # an idle lane of the packet
+                r = row0 + (p0 + lane) // tile_w
+                c = col0 + (p0 + lane) % tile_w
+                if p0 + lane >= tile_h * tile_w:
+                    continue
+                hit, d, t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, t_first, \
+                    t_last = _pixel_start(r, c, camera, height, width, mask, box_lo, box_hi,
+                                          vol_lo, vol_hi, exact, origin, inv, ds)
+                if not hit:
+                    continue
+                status[lane] = MARCH
+                rays[AX, lane], rays[AY, lane], rays[AZ, lane] = ax, ay, az
+                rays[BX, lane], rays[BY, lane], rays[BZ, lane] = bx, by, bz
+                rays[RED, lane] = rays[GREEN, lane] = rays[BLUE, lane] = rays[ALPHA, lane] = 0.0
+                ray_state[_D0, lane], ray_state[_D1, lane], ray_state[_D2, lane] = d
+                ray_state[_T_IN, lane], ray_state[_T_OUT, lane] = t_in, t_out
+                ray_state[_T_FIRST, lane], ray_state[_T_LAST, lane] = t_first, t_last
+                ray_state[_SPENT, lane] = 0.0  # the budget's share this ray has used
+                # Samples before t_check lie in a block already found not empty: no check
+                # needed (a sample that rounding puts in an empty block adds exactly nothing).
+                ray_state[_T_CHECK, lane] = -math.inf if block > 0 else math.inf
+                ray_state[_T_ENTER, lane] = 0.0
+                ray_steps[_ROW, lane], ray_steps[_COL, lane] = r, c
+                ray_steps[_K, lane] = k
+                ray_steps[_K_FIRST, lane], ray_steps[_K_LAST, lane] = k_first, k_last
+                # The step multiplier of the block before t_check (entered at t_enter), and
+                # where the ray's samples inside the volume end (-1: not found yet).
+                ray_steps[_M_BLOCK, lane] = 1
+                ray_steps[_INSIDE_END, lane] = -1
             while True:
-                t = (k + 0.5) * ds
-                fraction = 1.0
-                if k == k_first or k == k_last:
-                    t, fraction = _cut_segment(k, ds, t_first, t_last)
-                    if t < t_in:  # another brick's sample
-                        k += 1
+                for lane in range(LANES):
+                    if status[lane] != MARCH:
                         continue
-                if t >= t_out:
-                    break
-                ux = ax + t * bx
-                uy = ay + t * by
-                uz = az + t * bz
-                if skipping is not None and t >= t_check:
-                    k_next, t_check, spent = _skip(
-                        k, ux, uy, uz, ax, ay, az, bx, by, bz, ds, False, empty, clearance,
-                        block, fine_counts, bound, budget, spent, k_first,
-                        k_last, t_first, t_last, adaptive)
-                    if k_next > k:
-                        k = k_next
-                        continue
-                    if adaptive:
-                        m_block = _block_bound(multiplier, block, ux, uy, uz)
-                        t_enter = _entry(ax, ay, az, bx, by, bz, block, fine_counts, ux, uy,
-                                         uz)
-                if skipping is not None and m_block > 1:
-                    # Adaptive steps: one sample, at its middle, for an aligned run of m
-                    # segments inside this block (vrlib.adaptive bounds the change).
-                    k0, m = _long_segment(k, m_block, ds, t_enter, t_check, k_first, k_last)
-                    if m > 1:
-                        k = k0 + m - 1  # the last of the run: k + 1 follows it
-                        t = (k0 + 0.5 * m) * ds
-                        if t < t_in:  # another brick's sample
-                            k += 1
-                            continue
+                    d = (ray_state[_D0, lane], ray_state[_D1, lane], ray_state[_D2, lane])
+                    t_in, t_out = ray_state[_T_IN, lane], ray_state[_T_OUT, lane]
+                    t_first, t_last = ray_state[_T_FIRST, lane], ray_state[_T_LAST, lane]
+                    spent, t_check = ray_state[_SPENT, lane], ray_state[_T_CHECK, lane]
+                    t_enter = ray_state[_T_ENTER, lane]
+                    ax, ay, az = rays[AX, lane], rays[AY, lane], rays[AZ, lane]
+                    bx, by, bz = rays[BX, lane], rays[BY, lane], rays[BZ, lane]
+                    acc_r, acc_g = rays[RED, lane], rays[GREEN, lane]
+                    acc_b, acc_a = rays[BLUE, lane], rays[ALPHA, lane]
+                    k, k_first, k_last = ray_steps[_K, lane], ray_steps[_K_FIRST, lane], \
+                        ray_steps[_K_LAST, lane]
+                    m_block, inside_end = ray_steps[_M_BLOCK, lane], ray_steps[_INSIDE_END, lane]
+                    run = False
+                    while True:
+                        t = (k + 0.5) * ds
+                        fraction = 1.0
+                        if k == k_first or k == k_last:
+                            t, fraction = _cut_segment(k, ds, t_first, t_last)
+                            if t < t_in:  # another brick's sample
+                                k += 1
+                                continue
                         if t >= t_out:
                             break
                         ux = ax + t * bx
                         uy = ay + t * by
                         uz = az + t * bz
-                        fraction = float(m)
-                if (lighting is None and (filtering is None or fkind == TENT)
-                        and m_block == 1 and k != k_first and k != k_last):
-                    # A run of samples inside the volume, before the next skip check.
-                    j, acc, inside_end = _inside_run(
-                        k, t_check, k_last, t_in, t_out, gx1, gy1, gz1, ds, ax, ay, az, bx, by,
-                        bz, flat, nx, nxy, shift, tstart, tinv, alpha_tab, color_tab, grey,
-                        threshold, (acc_r, acc_g, acc_b, acc_a), inside_end)
-                    if j > k:
-                        acc_r, acc_g, acc_b, acc_a = acc
-                        taken += j - k
-                        k = j
+                        if skipping is not None and t >= t_check:
+                            k_next, t_check, spent = _skip(
+                                k, ux, uy, uz, ax, ay, az, bx, by, bz, ds, False, empty,
+                                clearance, block, fine_counts, bound, budget, spent, k_first,
+                                k_last, t_first, t_last, adaptive)
+                            if k_next > k:
+                                k = k_next
+                                continue
+                            if adaptive:
+                                m_block = _block_bound(multiplier, block, ux, uy, uz)
+                                t_enter = _entry(ax, ay, az, bx, by, bz, block, fine_counts,
+                                                 ux, uy, uz)
+                        if skipping is not None and m_block > 1:
+                            # Adaptive steps: one sample, at its middle, for an aligned run of
+                            # m segments inside this block (vrlib.adaptive bounds the change).
+                            k0, m = _long_segment(k, m_block, ds, t_enter, t_check, k_first,
+                                                  k_last)
+                            if m > 1:
+                                k = k0 + m - 1  # the last of the run: k + 1 follows it
+                                t = (k0 + 0.5 * m) * ds
+                                if t < t_in:  # another brick's sample
+                                    k += 1
+                                    continue
+                                if t >= t_out:
+                                    break
+                                ux = ax + t * bx
+                                uy = ay + t * by
+                                uz = az + t * bz
+                                fraction = float(m)
+                        if (lighting is None and (filtering is None or fkind == TENT)
+                                and m_block == 1 and k != k_first and k != k_last
+                                and _inside(k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in,
+                                            t_out)):
+                            # A run of samples inside the volume, up to the next skip check
+                            # (the samples inside form one interval per ray: its end, found
+                            # once, serves every run): taken with the other lanes' runs.
+                            if inside_end < 0:
+                                inside_end = _inside_end(k, ds, ax, ay, az, bx, by, bz, gx1,
+                                                         gy1, gz1, t_in, t_out, k_last)
+                            steps[K, lane] = k
+                            steps[END, lane] = _before(t_check, ds, k, inside_end)
+                            run = True
+                            break
+                        # The two common filters unrolled, the others through the general
+                        # loop.
+                        if filtering is None or fkind == TENT:
+                            value = trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz)
+                        elif fkind == CUBIC:
+                            value = tricubic(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz,
+                                             fp0, fp1, fp2)
+                        elif ntaps == 4:
+                            value = separable4(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy,
+                                               uz, fkind, fp0, fp1, fp2, radius)
+                        else:
+                            value = reconstruct(data, offset, gshape, ux, uy, uz, fkind, fp0,
+                                                fp1, fp2, radius, ntaps, wx, wy, wz)
+                        taken += 1
+                        k += 1
+                        # Classify: segment opacity 1 - exp(-density ds) (eq 1.4) and colour
+                        # E alpha (eq 1.9), from the table.
+                        i, w = lookup((value - tstart) * tinv, ntab)
+                        alpha = entry(alpha_tab, i, w)
+                        if not alpha > 0.0:
+                            continue  # a transparent segment adds exactly nothing
+                        if grey and not by_gradient:
+                            cr = cg = cb = alpha  # white emission, no shading: colour = opacity
+                        elif lighting is not None and (shade or by_gradient):
+                            gx_, gy_, gz_ = gradient(data, offset, gshape, ux, uy, uz, fkind,
+                                                     fp0, fp1, fp2, radius, ntaps, wx, wy, wz,
+                                                     dx, dy, dz)
+                            if headlight:
+                                lx, ly, lz = -d[0], -d[1], -d[2]
+                            else:
+                                lx, ly, lz = light[0], light[1], light[2]
+                            alpha, cr, cg, cb = classify_by_gradient(
+                                alpha, i, w, emit_tab, gx_ * inv[0], gy_ * inv[1],
+                                gz_ * inv[2], by_gradient, ramp_x, ramp_y, shade, lx, ly, lz,
+                                d[0], d[1], d[2], ka, kd, ks, shininess)
+                            if not alpha > 0.0:
+                                continue
+                        else:
+                            cr = entry_channel(color_tab, i, w, 0)
+                            cg = entry_channel(color_tab, i, w, 1)
+                            cb = entry_channel(color_tab, i, w, 2)
+                        if fraction != 1.0:  # a segment cut by the volume's face, or a long one
+                            part = _part_of_segment(alpha, fraction)
+                            cr *= part / alpha
+                            cg *= part / alpha
+                            cb *= part / alpha
+                            alpha = part
+                        # Front-to-back over, eqs 1.7-1.8.
+                        remaining = 1.0 - acc_a
+                        acc_r += remaining * cr
+                        acc_g += remaining * cg
+                        acc_b += remaining * cb
+                        acc_a += remaining * alpha
                         if acc_a >= threshold:
                             break
+                    if run:  # the lane waits for the packet where it stands
+                        status[lane] = RUN
+                        rays[RED, lane], rays[GREEN, lane] = acc_r, acc_g
+                        rays[BLUE, lane], rays[ALPHA, lane] = acc_b, acc_a
+                        ray_state[_SPENT, lane], ray_state[_T_CHECK, lane] = spent, t_check
+                        ray_state[_T_ENTER, lane] = t_enter
+                        ray_steps[_K, lane], ray_steps[_M_BLOCK, lane] = k, m_block
+                        ray_steps[_INSIDE_END, lane] = inside_end
                         continue
-                # The two common filters unrolled, the others through the general loop.
-                if filtering is None or fkind == TENT:
-                    value = trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz)
-                elif fkind == CUBIC:
-                    value = tricubic(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz,
-                                     fp0, fp1, fp2)
-                elif ntaps == 4:
-                    value = separable4(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz,
-                                       fkind, fp0, fp1, fp2, radius)
-                else:
-                    value = reconstruct(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1,
-                                        fp2, radius, ntaps, wx, wy, wz)
-                taken += 1
-                k += 1
-                # Classify: segment opacity 1 - exp(-density ds) (eq 1.4) and colour
-                # E alpha (eq 1.9), from the table.
-                i, w = lookup((value - tstart) * tinv, ntab)
-                alpha = entry(alpha_tab, i, w)
-                if not alpha > 0.0:
-                    continue  # a transparent segment adds exactly nothing
-                if grey and not by_gradient:
-                    cr = cg = cb = alpha  # white emission, no shading: colour = opacity
-                elif lighting is not None and (shade or by_gradient):
-                    gx_, gy_, gz_ = gradient(data, offset, gshape, ux, uy, uz, fkind, fp0,
-                                             fp1, fp2, radius, ntaps, wx, wy, wz, dx, dy,
-                                             dz)
-                    if headlight:
-                        lx, ly, lz = -d[0], -d[1], -d[2]
-                    else:
-                        lx, ly, lz = light[0], light[1], light[2]
-                    alpha, cr, cg, cb = classify_by_gradient(
-                        alpha, i, w, emit_tab, gx_ * inv[0], gy_ * inv[1], gz_ * inv[2],
-                        by_gradient, ramp_x, ramp_y, shade, lx, ly, lz, d[0], d[1], d[2],
-                        ka, kd, ks, shininess)
-                    if not alpha > 0.0:
-                        continue
-                else:
-                    cr = entry_channel(color_tab, i, w, 0)
-                    cg = entry_channel(color_tab, i, w, 1)
-                    cb = entry_channel(color_tab, i, w, 2)
-                if fraction != 1.0:  # a segment cut by the volume's face, or a long one
-                    part = _part_of_segment(alpha, fraction)
-                    cr *= part / alpha
-                    cg *= part / alpha
-                    cb *= part / alpha
-                    alpha = part
-                # Front-to-back over, eqs 1.7-1.8.
-                remaining = 1.0 - acc_a
-                acc_r += remaining * cr
-                acc_g += remaining * cg
-                acc_b += remaining * cb
-                acc_a += remaining * alpha
-                if acc_a >= threshold:
+                    status[lane] = DONE
+                    r, c = ray_steps[_ROW, lane], ray_steps[_COL, lane]
+                    out[r, c, 0] = acc_r
+                    out[r, c, 1] = acc_g
+                    out[r, c, 2] = acc_b
+                    out[r, c, 3] = acc_a
+                waiting = False
+                for lane in range(LANES):
+                    waiting = waiting or status[lane] == RUN
+                if not waiting:
                     break
-            out[r, c, 0] = acc_r
-            out[r, c, 1] = acc_g
-            out[r, c, 2] = acc_b
-            out[r, c, 3] = acc_a
+                inside_runs(flat, nx, nxy, shift, alpha_tab, color_tab, grey, ds, tstart,
+                            tinv, threshold, rays, steps)
+                for lane in range(LANES):
+                    if status[lane] != RUN:
+                        continue
+                    taken += steps[K, lane] - ray_steps[_K, lane]
+                    ray_steps[_K, lane] = steps[K, lane]
+                    steps[K, lane] = 0
+                    steps[END, lane] = 0
+                    status[lane] = MARCH
+                    if rays[ALPHA, lane] >= threshold:
+                        status[lane] = DONE
+                        r, c = ray_steps[_ROW, lane], ray_steps[_COL, lane]
+                        out[r, c, 0] = rays[RED, lane]
+                        out[r, c, 1] = rays[GREEN, lane]
+                        out[r, c, 2] = rays[BLUE, lane]
+                        out[r, c, 3] = rays[ALPHA, lane]
         samples[tile_id] = taken
