@@ -314,11 +314,12 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
     skips = (early_termination, *skip, np.zeros((1, 1, 1)) if bound is None else bound,
              float(budget))
     # The tiles, heaviest first, behind a queue that every thread takes the next one from;
-    # each thread's own scratch for the filter's weights.
+    # each thread's own scratch for the filter's weights (rows of MAX_TAPS = 8 floats, a
+    # cache line; an unused row between two threads' keeps them off each other's lines).
     tiles = (*TILE, live[np.argsort(-costs[live], kind="stable")], np.zeros(1, np.int64),
              out, samples)
     threads = numba.get_num_threads()
-    scratch = np.zeros((threads, 6, MAX_TAPS))
+    scratch = np.zeros((threads, 7, MAX_TAPS))[:, :6]
     if preintegrated:
         profile = "step" if filt.radius <= 0.5 else "linear"  # the box filter jumps
         arguments = (*layout, view.packed(), view.height, view.width, ds, *filt.code,
