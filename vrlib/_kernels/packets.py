@@ -297,9 +297,31 @@ def _inside_runs_intrinsic(colour):
                                                              byte_pointer),
                                             _I32(0), _I32(3), _I32(1)])  # read, keep, data
             both = builder.add(plane_step, row_step)
-            d = [corner(offset) for offset in (
-                zero_i, one_i, row_step, builder.add(row_step, one_i), plane_step,
-                builder.add(plane_step, one_i), both, builder.add(both, one_i))]
+            if stored == f64:
+                d = [corner(offset) for offset in (
+                    zero_i, one_i, row_step, builder.add(row_step, one_i), plane_step,
+                    builder.add(plane_step, one_i), both, builder.add(both, one_i))]
+            else:
+                # float32: a cell's two neighbours along x as one 8-byte item, four gathers
+                # instead of eight (the low half is the lower address's sample).
+                pairs = ir.VectorType(i64, LANES)
+                gather_pairs = cgutils.get_or_insert_function(
+                    builder.module, ir.FunctionType(pairs, [ir.VectorType(
+                        i64.as_pointer(), LANES), _I32, masks, pairs]),
+                    f"llvm.masked.gather.v{LANES}i64.v{LANES}p0")
+                halves = ir.VectorType(stored, 2 * LANES)
+                even = ir.Constant(ir.VectorType(_I32, LANES), list(range(0, 2 * LANES, 2)))
+                odd = ir.Constant(ir.VectorType(_I32, LANES), list(range(1, 2 * LANES, 2)))
+                d = []
+                for offset in (zero_i, row_step, plane_step, both):
+                    address = builder.add(volume_start, builder.mul(
+                        builder.add(base, offset), constant(size, ints)))
+                    pair = builder.call(gather_pairs, [
+                        builder.inttoptr(address, ir.VectorType(i64.as_pointer(), LANES)),
+                        _I32(size), active, ir.Constant(pairs, None)])
+                    split = builder.bitcast(pair, halves)
+                    d.append(builder.shuffle_vector(split, ir.Constant(halves, None), even))
+                    d.append(builder.shuffle_vector(split, ir.Constant(halves, None), odd))
 
             def widen(value):
                 return value if stored == f64 else builder.fpext(value, floats)
