@@ -30,8 +30,10 @@ from vrlib.volume import lattice_extent
 __all__ = ["render_raycast", "cast_rays", "segment_options", "operations_per_sample",
            "skip_bounds", "brightest"]
 
-#: Pixels (rows, columns) of the image tiles that the threads take from the queue.
-TILE = (32, 32)
+#: Pixels (rows, columns) of the image tiles that the threads take from the queue. Packets
+#: go along a tile's rows: wide tiles keep the next packets on the lines the last ones
+#: fetched (256^3 -> 512^2, 2 threads: 8 x 128 took 72 ms where 32 x 32 took 75).
+TILE = (8, 128)
 
 
 def operations_per_sample(filt, *, shading=False):
