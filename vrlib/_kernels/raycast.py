@@ -72,7 +72,6 @@ _STEP_ROWS = 7
 DONE, MARCH, RUN = 0, 1, 2
 
 
-
 def lanes(threads):
     """Each thread's lanes for :func:`raycast` (``[thread]`` of each array): its rays and
     packet state (:mod:`vrlib._kernels.packets`), the rest of each ray's state, and whether
