@@ -228,17 +228,17 @@ def _inside_runs_intrinsic(colour):
             color_row = _splat(builder, builder.extract_value(color_tab.strides, 0), ints)
             color_column = builder.extract_value(color_tab.strides, 1)
 
-            def gather_function(element, pointer):
+            def gather_function(element):
                 vector = ir.VectorType(element, LANES)
-                name = "f64" if element == f64 else "f32"
+                name = {f64: "f64", i64: "i64"}.get(element, "f32")
                 return cgutils.get_or_insert_function(
                     builder.module,
-                    ir.FunctionType(vector, [ir.VectorType(pointer, LANES), _I32, masks,
-                                             vector]),
+                    ir.FunctionType(vector, [ir.VectorType(element.as_pointer(), LANES), _I32,
+                                             masks, vector]),
                     f"llvm.masked.gather.v{LANES}{name}.v{LANES}p0")
 
-            gather_volume = gather_function(stored, volume.data.type)
-            gather_table = gather_function(f64, alpha_tab.data.type)
+            gather_volume = gather_function(stored)
+            gather_table = gather_function(f64)
             any_lane = cgutils.get_or_insert_function(
                 builder.module, ir.FunctionType(i1, [masks]), f"llvm.vector.reduce.or.v{LANES}i1")
 
@@ -304,21 +304,14 @@ def _inside_runs_intrinsic(colour):
             else:
                 # float32: a cell's two neighbours along x as one 8-byte item, four gathers
                 # instead of eight (the low half is the lower address's sample).
-                pairs = ir.VectorType(i64, LANES)
-                gather_pairs = cgutils.get_or_insert_function(
-                    builder.module, ir.FunctionType(pairs, [ir.VectorType(
-                        i64.as_pointer(), LANES), _I32, masks, pairs]),
-                    f"llvm.masked.gather.v{LANES}i64.v{LANES}p0")
+                gather_pairs = gather_function(i64)
                 halves = ir.VectorType(stored, 2 * LANES)
                 even = ir.Constant(ir.VectorType(_I32, LANES), list(range(0, 2 * LANES, 2)))
                 odd = ir.Constant(ir.VectorType(_I32, LANES), list(range(1, 2 * LANES, 2)))
                 d = []
                 for offset in (zero_i, row_step, plane_step, both):
-                    address = builder.add(volume_start, builder.mul(
-                        builder.add(base, offset), constant(size, ints)))
-                    pair = builder.call(gather_pairs, [
-                        builder.inttoptr(address, ir.VectorType(i64.as_pointer(), LANES)),
-                        _I32(size), active, ir.Constant(pairs, None)])
+                    pair = _gather(builder, gather_pairs, volume_start, builder.add(base, offset),
+                                   size, active, ir.VectorType(i64, LANES))
                     split = builder.bitcast(pair, halves)
                     d.append(builder.shuffle_vector(split, ir.Constant(halves, None), even))
                     d.append(builder.shuffle_vector(split, ir.Constant(halves, None), odd))
