@@ -67,8 +67,8 @@ from vrlib._kernels.tables import entry, entry_channel, interpolate, interpolate
 # steps): rows of a float and an integer array, one column per lane; and its status.
 _D0, _D1, _D2, _T_IN, _T_OUT, _T_FIRST, _T_LAST, _SPENT, _T_CHECK, _T_ENTER = range(10)
 _STATE_ROWS = 10
-_ROW, _COL, _K, _K_FIRST, _K_LAST, _M_BLOCK, _INSIDE_END = range(7)
-_STEP_ROWS = 7
+_K, _K_FIRST, _K_LAST, _M_BLOCK, _INSIDE_END = range(5)
+_STEP_ROWS = 5
 DONE, MARCH, RUN = 0, 1, 2
 
 
@@ -180,6 +180,15 @@ def _inside(k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in, t_out):
     uz = az + t * bz
     return (t_in <= t < t_out and 0.0 <= ux < gx1 and 0.0 <= uy < gy1
             and 0.0 <= uz < gz1)
+
+
+@jit(inline="always")
+def _put_pixel(out, r, c, red, green, blue, alpha):
+    """A ray's colour and opacity into its pixel."""
+    out[r, c, 0] = red
+    out[r, c, 1] = green
+    out[r, c, 2] = blue
+    out[r, c, 3] = alpha
 
 
 @jit(inline="always")
@@ -676,7 +685,6 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                 # needed (a sample that rounding puts in an empty block adds exactly nothing).
                 ray_state[_T_CHECK, lane] = -math.inf if block > 0 else math.inf
                 ray_state[_T_ENTER, lane] = 0.0
-                ray_steps[_ROW, lane], ray_steps[_COL, lane] = r, c
                 ray_steps[_K, lane] = k
                 ray_steps[_K_FIRST, lane], ray_steps[_K_LAST, lane] = k_first, k_last
                 # The step multiplier of the block before t_check (entered at t_enter), and
@@ -821,11 +829,8 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                         ray_steps[_INSIDE_END, lane] = inside_end
                         continue
                     status[lane] = DONE
-                    r, c = ray_steps[_ROW, lane], ray_steps[_COL, lane]
-                    out[r, c, 0] = acc_r
-                    out[r, c, 1] = acc_g
-                    out[r, c, 2] = acc_b
-                    out[r, c, 3] = acc_a
+                    _put_pixel(out, row0 + (p0 + lane) // tile_w, col0 + (p0 + lane) % tile_w,
+                               acc_r, acc_g, acc_b, acc_a)
                 waiting = False
                 for lane in range(LANES):
                     waiting = waiting or status[lane] == RUN
@@ -843,9 +848,7 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                     status[lane] = MARCH
                     if rays[ALPHA, lane] >= threshold:
                         status[lane] = DONE
-                        r, c = ray_steps[_ROW, lane], ray_steps[_COL, lane]
-                        out[r, c, 0] = rays[RED, lane]
-                        out[r, c, 1] = rays[GREEN, lane]
-                        out[r, c, 2] = rays[BLUE, lane]
-                        out[r, c, 3] = rays[ALPHA, lane]
+                        _put_pixel(out, row0 + (p0 + lane) // tile_w,
+                                   col0 + (p0 + lane) % tile_w, rays[RED, lane],
+                                   rays[GREEN, lane], rays[BLUE, lane], rays[ALPHA, lane])
         samples[tile_id] = taken
