@@ -6,7 +6,7 @@ from naive import reconstruct_naive
 
 import data_gen
 from vrlib import Glow, LookupTransfer, View, Volume, make_filter, render
-from vrlib.skipping import clearance, empty_blocks, skip_grid
+from vrlib.skipping import clearance, empty_blocks, footprint_mask, skip_grid
 from vrlib.value_bounds import lattice_sums
 
 
@@ -82,6 +82,30 @@ def test_clearance_is_the_distance_to_the_other_kind(seed):
         assert distance[other].min() == abs(d)
     assert (clearance(np.ones((2, 3, 4), bool)) == 4).all()
     assert (clearance(np.zeros((2, 3, 4), bool)) == -4).all()
+
+
+@pytest.mark.parametrize("projection, seed", [("orthographic", 0), ("orthographic", 1),
+                                              ("perspective", 2), ("orthographic", 3)])
+def test_footprint_mask_is_each_blocks_rectangle_painted(projection, seed):
+    """The pixels whose rays may meet a non-empty block (the ray caster samples no other):
+    the union of the blocks' projected corner rectangles, one pixel wider all round. Painted
+    here block by block, and compared pixel for pixel with the mask built from marks and
+    prefix sums, on random grids (sparse to nearly empty) and a zoomed, non-square view
+    whose rectangles run off the image."""
+    rng = np.random.default_rng(seed)
+    volume = Volume(np.zeros((24, 40, 32)), spacing=(1.0, 0.5, 2.0))
+    empty = rng.random((3, 5, 4)) < (0.5, 0.8, 0.9, 0.97)[seed]
+    view = View.fit(volume, size=(37, 53), azimuth=25.0 * seed + 10.0, elevation=20.0 - 9 * seed,
+                    projection=projection, zoom=2.5 if seed == 3 else 1.0)
+    painted = np.zeros(view.shape, dtype=bool)
+    for bz, by, bx in np.argwhere(~empty):
+        corners = [[min((bx + i) * 8, 31), min((by + j) * 8, 39), min((bz + k) * 8, 23)]
+                   for i in (0, 1) for j in (0, 1) for k in (0, 1)]
+        rc = view.project(volume.origin + np.array(corners) * volume.spacing)[:, :2]
+        r0, c0 = np.floor(rc.min(axis=0)).astype(int) - 1
+        r1, c1 = np.floor(rc.max(axis=0)).astype(int) + 2
+        painted[max(r0, 0):max(r1, 0), max(c0, 0):max(c1, 0)] = True
+    np.testing.assert_array_equal(footprint_mask(view, volume, empty, 8), painted)
 
 
 @pytest.mark.parametrize("method, options", [
