@@ -225,7 +225,7 @@ def _composite_band(run_ptr, run_start, run_end, run_voxel, sigma, emission_code
             # Walk the segments over which each stream stays inside one run or outside all:
             # within one, a run's voxel for the pixel is base + pixel (VolPack's run
             # merging), and the loop over the segment's open pixels keeps no books.
-            visited = 0
+            visited = closed = 0
             while True:
                 pos = _open(links, r, pos)  # past opaque pixels: their voxels are skipped
                 if pos >= hi:
@@ -274,11 +274,15 @@ def _composite_band(run_ptr, run_start, run_end, run_voxel, sigma, emission_code
                                 at(inter, (row, pixel, 2)) + remaining * (cb * scale))
                         acc += remaining * alpha
                         put(inter, (row, pixel, 3), acc)
-                        if acc >= threshold:
-                            put(links, (r, pixel), pixel + 1)
-                            opaque[r] += 1
+                        # Opaque now: linked past. Without a branch: the test waits on
+                        # the whole chain of the sample (its exp), and a branch on it
+                        # would often be mispredicted, faint samples among opaque ones.
+                        now_opaque = np.int64(acc >= threshold)
+                        put(links, (r, pixel), pixel + now_opaque)
+                        closed += now_opaque
                     pixel = _open(links, r, pixel + 1)
                 pos = following
             taken[r] += visited
+            opaque[r] += closed
     for r in range(rows):
         counts[first_row + r] = taken[r]
