@@ -15,6 +15,7 @@ import data_gen
 import vrlib
 from vrlib import Glow, LookupTransfer, View, Volume, metrics, render
 from vrlib.shear import plan_shear
+from vrlib.shearwarp import warp
 
 TABLE = LookupTransfer([0.0, 3.0, 1.0, 5.0], [[1, 0, 0], [0, 1, 0], [0, 0, 1], [1, 1, 1]])
 FILTERS = ["box", "trilinear", "catmull-rom", "gaussian", "omoms"]
@@ -285,3 +286,53 @@ def test_perspective_shearwarp_refuses_an_eye_inside_the_slab():
 def test_bad_input(method, kwargs, error, message):
     with pytest.raises(error, match=message):
         render(small_volume(), View.orbit(size=8), method=method, **kwargs)
+
+
+def _warp_by_numpy(inter, m, shape, grey):
+    """The affine warp's documented arithmetic on whole arrays: bilinear in ``inter`` at
+    ``(x, y) = (m00 c + m01 r + m02, m10 c + m11 r + m12)``, clipped to [0, 1], transparent
+    outside or where all four neighbours are."""
+    n_j, n_i = inter.shape[:2]
+    rows, cols = np.meshgrid(np.arange(shape[0]), np.arange(shape[1]), indexing="ij")
+    x = m[0, 0] * cols + (m[0, 1] * rows + m[0, 2])
+    y = m[1, 0] * cols + (m[1, 1] * rows + m[1, 2])
+    inside = (x >= 0.0) & (y >= 0.0) & (x <= n_i - 1) & (y <= n_j - 1)
+    i = np.minimum(np.where(inside, x, 0.0).astype(int), n_i - 2)
+    j = np.minimum(np.where(inside, y, 0.0).astype(int), n_j - 2)
+    tx, ty = x - i, y - j
+    corners = [inter[j, i], inter[j, i + 1], inter[j + 1, i], inter[j + 1, i + 1]]
+    top = (1 - tx)[..., None] * corners[0] + tx[..., None] * corners[1]
+    bottom = (1 - tx)[..., None] * corners[2] + tx[..., None] * corners[3]
+    value = np.minimum(np.maximum((1 - ty)[..., None] * top + ty[..., None] * bottom, 0.0), 1.0)
+    if grey:
+        value[..., 1] = value[..., 2] = value[..., 0]
+    clear = np.all([c[..., 3] == 0.0 for c in corners], axis=0)
+    value[~inside | clear] = 0.0
+    return value
+
+
+@pytest.mark.parametrize("grey", [True, False])
+@pytest.mark.parametrize("seed", range(3))
+def test_affine_warp_is_its_arithmetic_bit_for_bit(grey, seed):
+    """The affine warp takes eight pixels at once in vector form (gathers of the four
+    neighbours, one store of the eight pixels) and the rest of a row one at a time: both
+    must be the documented arithmetic exactly. Random intermediate images (values outside
+    [0, 1] to clip, transparent patches, grey or coloured), rotated, scaled and shifted
+    maps, rows whose pixels fall inside, across and outside the image; compared bit for
+    bit with numpy's whole-array arithmetic."""
+    rng = np.random.default_rng(seed)
+    inter = rng.random((37, 45, 4)) * 1.4 - 0.2
+    inter[rng.random((37, 45)) < 0.3] = 0.0
+    inter[:5] = 0.0  # a transparent margin: the box the warp visits is smaller
+    if grey:
+        inter[..., 1] = inter[..., 2] = inter[..., 0]
+    angle, scale = rng.uniform(0, 2 * np.pi), rng.uniform(0.6, 1.5)
+    m = np.array([[scale * np.cos(angle), -scale * np.sin(angle), 0.0],
+                  [scale * np.sin(angle), scale * np.cos(angle), 0.0], [0.0, 0.0, 1.0]])
+    # The image's centre to the intermediate image's, give or take a few pixels.
+    m[:2, 2] = [22.0, 18.0] - m[:2, :2] @ [30.0, 26.0] + rng.uniform(-8, 8, 2)
+    out = np.full((53, 61, 4), np.nan)
+    warp(inter, m, out, grey)
+    expected = _warp_by_numpy(inter, m, out.shape[:2], grey)
+    assert (expected[..., 3] > 0).sum() > 100  # the test sees pixels, not only margins
+    np.testing.assert_array_equal(out, expected)

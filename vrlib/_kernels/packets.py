@@ -1,4 +1,4 @@
-"""Ray packets: eight rays at once, in vector form.
+"""Packets: eight rays, or eight pixels, at once in vector form.
 
 numba has no vector types, and LLVM, as numba drives it, vectorises neither a loop over lanes
 that reads a table at eight indices nor the arithmetic around it (docs/kernel.md, "Packets").
@@ -13,6 +13,11 @@ AVX-512 gather where the CPU has one, scalar loads elsewhere); the lerps run on 
   lane it does the scalar loop's arithmetic, in the same order (the corners' differences in
   the stored type, as numba's scalar code takes them), so images are the same bit for bit.
   It asks for the cells a few samples ahead (``llvm.prefetch``).
+* :func:`warp_octet_grey` and :func:`warp_octet_colour` are eight pixels of shear-warp's
+  affine warp (:func:`vrlib._kernels.shear.warp_octet`): the four neighbours of each pixel
+  gathered per channel, the bilinear weights, clipping and the transparent test as vector
+  operations and selects (numba's own ``min`` and ``max`` are selects too), the eight pixels
+  interleaved into one store. Bit for bit the scalar pixel's arithmetic.
 * :func:`trilinear_packet` is one trilinear sample of eight rays: the roofline measures it
   beside the scalar loop (:mod:`vrlib.roofline`), the packet-sampling ceiling. It widens
   float32 samples before their differences (within float32 rounding of the scalar loop).
@@ -463,3 +468,125 @@ table ``alpha_tab`` over ``(value - tstart) tinv`` (and colour from ``color_tab`
 unless ``grey``: then the colour is the opacity), and composited front to back onto rows
 ``RED..ALPHA``, until the lane's opacity reaches ``threshold``. On return ``steps[K]`` holds
 each lane's next sample and ``rays`` its colour and opacity."""
+
+
+def _warp_octet_intrinsic(colour):
+    """The intrinsic behind :func:`vrlib._kernels.shear.warp_octet`, for grey (``colour``
+    False: red alone is interpolated and copied to green and blue) or coloured images."""
+
+    @intrinsic
+    def octet(typingctx, src, n_i, n_j, out, at_out, c0, mx, ax, my, ay):
+        if not (all(isinstance(a, types.Array) and a.ndim == 1 and a.layout == "C"
+                    and a.dtype == types.float64 for a in (src, out)) and out.mutable
+                and all(isinstance(n, types.Integer) for n in (n_i, n_j, at_out, c0))
+                and all(isinstance(x, types.Float) for x in (mx, ax, my, ay))):
+            return None
+
+        def codegen(context, builder, signature, args):
+            sig = signature.args
+            f64, i64, i1 = ir.DoubleType(), ir.IntType(64), ir.IntType(1)
+            floats, ints = ir.VectorType(f64, LANES), ir.VectorType(i64, LANES)
+            masks = ir.VectorType(i1, LANES)
+
+            def scalar(index):  # an integer argument as intp, a float as float64
+                target = types.float64 if isinstance(sig[index], types.Float) else types.intp
+                return context.cast(builder, args[index], sig[index], target)
+
+            def splat_f(value):
+                return _splat(builder, value, floats)
+
+            def splat_i(value):
+                return _splat(builder, value, ints)
+
+            source = context.make_array(sig[0])(context, builder, args[0])
+            image = context.make_array(sig[3])(context, builder, args[3])
+            n_i, n_j = scalar(1), scalar(2)
+            # Each lane's pixel column and where its ray meets the intermediate image, as the
+            # scalar warp computes them: x = mx c + ax, y = my c + ay.
+            column = builder.add(splat_i(scalar(5)), ir.Constant(ints, list(range(LANES))))
+            c = builder.sitofp(column, floats)
+            x = builder.fadd(builder.fmul(splat_f(scalar(6)), c), splat_f(scalar(7)))
+            y = builder.fadd(builder.fmul(splat_f(scalar(8)), c), splat_f(scalar(9)))
+            zero_f = ir.Constant(floats, [0.0] * LANES)
+            one_f = ir.Constant(floats, [1.0] * LANES)
+            last_i = splat_f(builder.sitofp(builder.sub(n_i, i64(1)), f64))
+            last_j = splat_f(builder.sitofp(builder.sub(n_j, i64(1)), f64))
+            inside = builder.and_(
+                builder.and_(builder.fcmp_ordered(">=", x, zero_f),
+                             builder.fcmp_ordered(">=", y, zero_f)),
+                builder.and_(builder.fcmp_ordered("<=", x, last_i),
+                             builder.fcmp_ordered("<=", y, last_j)))
+            # The cell (min(int(x), n_i - 2), likewise for y) of the lanes inside; 0 elsewhere
+            # (their loads are masked off).
+            def cell(u, n):
+                whole = builder.fptosi(builder.select(inside, u, zero_f), ints)
+                top = splat_i(builder.sub(n, i64(2)))
+                return builder.select(builder.icmp_signed("<", top, whole), top, whole)
+
+            i, j = cell(x, n_i), cell(y, n_j)
+            tx = builder.fsub(x, builder.sitofp(i, floats))
+            ty = builder.fsub(y, builder.sitofp(j, floats))
+            row = builder.mul(splat_i(n_i), ir.Constant(ints, [4] * LANES))
+            base = builder.mul(builder.add(builder.mul(j, splat_i(n_i)), i),
+                               ir.Constant(ints, [4] * LANES))
+            start = splat_i(builder.ptrtoint(source.data, i64))
+            gather = cgutils.get_or_insert_function(
+                builder.module,
+                ir.FunctionType(floats, [ir.VectorType(f64.as_pointer(), LANES), _I32, masks,
+                                         floats]),
+                f"llvm.masked.gather.v{LANES}f64.v{LANES}p0")
+
+            def corners(channel):  # (j, i), (j, i + 1), (j + 1, i), (j + 1, i + 1)
+                first = builder.add(base, ir.Constant(ints, [channel] * LANES))
+                right = ir.Constant(ints, [4] * LANES)
+                return [_gather(builder, gather, start, builder.add(first, offset), 8, inside,
+                                floats)
+                        for offset in (ir.Constant(ints, [0] * LANES), right, row,
+                                       builder.add(row, right))]
+
+            def clipped(value):  # min(max(value, 0.0), 1.0), as numba's min and max select
+                value = builder.select(builder.fcmp_ordered(">", zero_f, value), zero_f, value)
+                return builder.select(builder.fcmp_ordered("<", one_f, value), one_f, value)
+
+            wx, wy = builder.fsub(one_f, tx), builder.fsub(one_f, ty)
+
+            def bilinear(d):
+                top = builder.fadd(builder.fmul(wx, d[0]), builder.fmul(tx, d[1]))
+                bottom = builder.fadd(builder.fmul(wx, d[2]), builder.fmul(tx, d[3]))
+                return clipped(builder.fadd(builder.fmul(wy, top), builder.fmul(ty, bottom)))
+
+            a = corners(3)
+            # Transparent where all four neighbours are (colours are premultiplied).
+            clear = builder.and_(
+                builder.and_(builder.fcmp_ordered("==", a[0], zero_f),
+                             builder.fcmp_ordered("==", a[1], zero_f)),
+                builder.and_(builder.fcmp_ordered("==", a[2], zero_f),
+                             builder.fcmp_ordered("==", a[3], zero_f)))
+            seen = builder.and_(inside, builder.not_(clear))
+            red = bilinear(corners(0))
+            green, blue = (bilinear(corners(1)), bilinear(corners(2))) if colour else (red, red)
+            channels = [builder.select(seen, value, zero_f)
+                        for value in (red, green, blue, bilinear(a))]
+            # Interleaved into the pixels' (r, g, b, a), one store of 4 LANES floats.
+            pairs = [(lane, lane + LANES) for lane in range(LANES)]
+            rg = builder.shuffle_vector(channels[0], channels[1], ir.Constant(
+                ir.VectorType(_I32, 2 * LANES), [n for pair in pairs for n in pair]))
+            ba = builder.shuffle_vector(channels[2], channels[3], ir.Constant(
+                ir.VectorType(_I32, 2 * LANES), [n for pair in pairs for n in pair]))
+            order = [n for lane in range(LANES)
+                     for n in (2 * lane, 2 * lane + 1, 2 * LANES + 2 * lane,
+                               2 * LANES + 2 * lane + 1)]
+            pixels = builder.shuffle_vector(rg, ba, ir.Constant(
+                ir.VectorType(_I32, 4 * LANES), order))
+            target = builder.gep(image.data, [scalar(4)])
+            builder.store(pixels, builder.bitcast(
+                target, ir.VectorType(f64, 4 * LANES).as_pointer()), align=8)
+            return context.get_dummy_value()
+
+        return types.none(src, n_i, n_j, out, at_out, c0, mx, ax, my, ay), codegen
+
+    return octet
+
+
+warp_octet_grey = _warp_octet_intrinsic(colour=False)
+warp_octet_colour = _warp_octet_intrinsic(colour=True)

@@ -13,11 +13,13 @@ from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
 from numba import prange
 
 from vrlib._kernels._jit import at, borrowed, helper_jit, jit, parallel_jit, put
 from vrlib._kernels.filters import CUBIC, MAX_TAPS, TENT, weight
+from vrlib._kernels.packets import LANES, warp_octet_colour, warp_octet_grey
 from vrlib._kernels.queue import take
 from vrlib._kernels.sampling import clamp, cubic_weights, filter_taps
 from vrlib._kernels.shading import classify_by_gradient
@@ -524,6 +526,33 @@ def _warp_pixel(inter, x, y, out, row, c, grey):
     put(out, (row, c, 3), alpha)
 
 
+def _warp_octet_lanes(inter, src, mx, ax, my, ay, out, flat, row, c, grey):
+    """:func:`warp_octet` one pixel at a time (without the JIT): :func:`_warp_pixel`."""
+    for lane in range(LANES):
+        _warp_pixel(inter, mx * (c + lane) + ax, my * (c + lane) + ay, out, row, c + lane,
+                    grey)
+
+
+@jit(inline="always")
+def _warp_octet_compiled(inter, src, mx, ax, my, ay, out, flat, row, c, grey):
+    at_out = (row * out.shape[1] + c) * 4
+    if grey:
+        warp_octet_grey(src, inter.shape[1], inter.shape[0], flat, at_out, c, mx, ax, my, ay)
+    else:
+        warp_octet_colour(src, inter.shape[1], inter.shape[0], flat, at_out, c, mx, ax, my,
+                          ay)
+
+
+warp_octet = _warp_octet_lanes if numba.config.DISABLE_JIT else _warp_octet_compiled
+"""``warp_octet(inter, src, mx, ax, my, ay, out, flat, row, c, grey)``: pixels
+``c .. c + LANES - 1``
+of row ``row`` of the affine warp (:func:`warp_rows`; pixel ``c`` samples ``inter`` at
+``(mx c + ax, my c + ay)``) at once, in vector form
+(:func:`vrlib._kernels.packets.warp_octet_grey` and ``_colour``): :func:`_warp_pixel`'s
+arithmetic lane by lane, so the image is the same bit for bit. ``inter`` and ``out``
+C-contiguous, ``src`` and ``flat`` their raveled views."""
+
+
 @jit(inline="always")
 def _bilinear(inter, j, i, ch, tx, ty):
     """Channel ``ch`` of ``inter`` at ``(i + tx, j + ty)``, clipped to [0, 1]."""
@@ -599,13 +628,14 @@ def warp_rows(inter, m, out, grey, seen, band_rows, counter):
     inter, m, out, seen = borrowed(inter), borrowed(m), borrowed(out), borrowed(seen)
     height, width = out.shape[0], out.shape[1]
     affine = m[2, 0] == 0.0 and m[2, 1] == 0.0 and m[2, 2] == 1.0
+    src, flat = inter.reshape(-1), out.reshape(-1)
     while True:
         first_row = take(counter) * band_rows
         if first_row >= height:
             break
         for row in range(first_row, min(first_row + band_rows, height)):
             if affine:
-                _warp_affine_row(inter, m, out, grey, seen, row, width)
+                _warp_affine_row(inter, src, m, out, flat, grey, seen, row, width)
                 continue
             for c in range(width):
                 d = m[2, 0] * c + m[2, 1] * row + m[2, 2]
@@ -618,7 +648,7 @@ def warp_rows(inter, m, out, grey, seen, band_rows, counter):
 
 
 @jit(inline="always")
-def _warp_affine_row(inter, m, out, grey, seen, row, width):
+def _warp_affine_row(inter, src, m, out, flat, grey, seen, row, width):
     """Row ``row`` of the affine warp (:func:`warp_rows`)."""
     ax = m[0, 1] * row + m[0, 2]
     ay = m[1, 1] * row + m[1, 2]
@@ -632,7 +662,10 @@ def _warp_affine_row(inter, m, out, grey, seen, row, width):
     for c in range(first):
         for ch in range(4):
             put(out, (row, c, ch), 0.0)
-    for c in range(first, stop):
+    octets = first + (stop - first) // LANES * LANES
+    for c in range(first, octets, LANES):  # LANES pixels at once, in vector form
+        warp_octet(inter, src, mx, ax, my, ay, out, flat, row, c, grey)
+    for c in range(octets, stop):
         _warp_pixel(inter, mx * c + ax, my * c + ay, out, row, c, grey)
     for c in range(stop, width):
         for ch in range(4):
