@@ -226,8 +226,7 @@ class View:
         (True, False)
         """
         box = np.asarray(extent, dtype=np.float64)
-        corners = np.array([[box[0, i], box[1, j], box[2, k]]
-                            for i in (0, 1) for j in (0, 1) for k in (0, 1)])
+        corners = box[_AXES, _CORNERS]  # (8, 3): x, y, z each at its low or high end
         if self.is_perspective:
             depth = self.to_camera(corners)[:, 2]
             if np.all(depth <= 0.0):
@@ -403,6 +402,11 @@ class View:
             f"View(forward=[{f}], size=({self.height}, {self.width}), "
             f"projection={self.projection!r}, zoom={self.zoom:g}{extra})"
         )
+
+
+#: The eight corners of a box, as the end (0 low, 1 high) each axis takes.
+_CORNERS = np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)])
+_AXES = np.arange(3)
 
 
 def extent_of(scene):
