@@ -300,6 +300,8 @@ def _warp_by_numpy(inter, m, shape, grey):
     i = np.minimum(np.where(inside, x, 0.0).astype(int), n_i - 2)
     j = np.minimum(np.where(inside, y, 0.0).astype(int), n_j - 2)
     tx, ty = x - i, y - j
+    if inter.shape[2] == 2:  # grey: red and opacity alone
+        inter = inter[..., [0, 0, 0, 1]]
     corners = [inter[j, i], inter[j, i + 1], inter[j + 1, i], inter[j + 1, i + 1]]
     top = (1 - tx)[..., None] * corners[0] + tx[..., None] * corners[1]
     bottom = (1 - tx)[..., None] * corners[2] + tx[..., None] * corners[3]
@@ -311,21 +313,24 @@ def _warp_by_numpy(inter, m, shape, grey):
     return value
 
 
-@pytest.mark.parametrize("grey", [True, False])
+@pytest.mark.parametrize("grey, channels", [(True, 4), (True, 2), (False, 4)])
 @pytest.mark.parametrize("seed", range(3))
-def test_affine_warp_is_its_arithmetic_bit_for_bit(grey, seed):
+def test_affine_warp_is_its_arithmetic_bit_for_bit(grey, channels, seed):
     """The affine warp takes eight pixels at once in vector form (gathers of the four
     neighbours, one store of the eight pixels) and the rest of a row one at a time: both
     must be the documented arithmetic exactly. Random intermediate images (values outside
     [0, 1] to clip, transparent patches, grey or coloured), rotated, scaled and shifted
-    maps, rows whose pixels fall inside, across and outside the image; compared bit for
-    bit with numpy's whole-array arithmetic."""
+    maps, rows whose pixels fall inside, across and outside the image, grey images also
+    as red and opacity alone (the classified renderer's); compared bit for bit with numpy's
+    whole-array arithmetic."""
     rng = np.random.default_rng(seed)
     inter = rng.random((37, 45, 4)) * 1.4 - 0.2
     inter[rng.random((37, 45)) < 0.3] = 0.0
     inter[:5] = 0.0  # a transparent margin: the box the warp visits is smaller
     if grey:
         inter[..., 1] = inter[..., 2] = inter[..., 0]
+    if channels == 2:
+        inter = np.ascontiguousarray(inter[..., [0, 3]])
     angle, scale = rng.uniform(0, 2 * np.pi), rng.uniform(0.6, 1.5)
     m = np.array([[scale * np.cos(angle), -scale * np.sin(angle), 0.0],
                   [scale * np.sin(angle), scale * np.cos(angle), 0.0], [0.0, 0.0, 1.0]])

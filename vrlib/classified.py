@@ -285,13 +285,17 @@ class ClassifiedVolume:
             order = np.arange(n_k) if ascending else np.arange(n_k)[::-1].copy()
             length = float(volume.spacing[axis] / abs(view.forward[axis]))
             factor, highlight = self._shade_tables(view, shading)
-            inter = np.zeros((height, width, 4))
+            # Grey: red and opacity alone (the warp copies red), half the memory.
+            inter = np.zeros((height, width, 2 if self._grey else 4))
             counts = np.zeros(height, np.int64)
+            # The bands in order on one thread; the heaviest first on several, for balance.
+            threads = numba.get_num_threads()
+            bands = (self._band_order(axis, dj, height) if threads > 1 else
+                     np.arange(-(-height // BAND)))
             arguments = (*encoded, n_j, order, di, dj, length, self._emission, factor,
-                         highlight, self._grey, shading is not None, threshold, BAND,
-                         self._band_order(axis, dj, height), np.zeros(1, np.int64), inter,
-                         counts)
-            on_threads(lambda i: composite_classified(*arguments), numba.get_num_threads())
+                         highlight, self._grey, shading is not None, threshold, BAND, bands,
+                         np.zeros(1, np.int64), inter, counts)
+            on_threads(lambda i: composite_classified(*arguments), threads)
             plane = volume.origin[axis] + kf * volume.spacing[axis]
             out = np.empty(view.shape + (4,))
             warp(inter, warp_homography(view, volume, axis, plane, (oi, oj)), out, self._grey)

@@ -138,7 +138,8 @@ def warp_homography(view, volume, axis, plane, offsets):
 
 def warp(inter, homography, out, grey=False):
     """The 2-D warp into ``out`` (``(height, width, 4)``): each pixel ``(c, r)`` samples
-    ``inter`` bilinearly at ``(A / D, B / D)`` with ``(A, B, D) = homography @ (c, r, 1)``
+    ``inter`` (RGBA, or for a ``grey`` image red and opacity alone: ``(.., .., 2)``)
+    bilinearly at ``(A / D, B / D)`` with ``(A, B, D) = homography @ (c, r, 1)``
     (:func:`warp_homography`), on numba's thread count
     (:func:`vrlib._kernels.shear.warp_rows`, which says what it skips).
 

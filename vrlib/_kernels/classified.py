@@ -137,7 +137,8 @@ def _pair(v, w_left, w_right, sigma, emission_code, normal_code, emission, facto
 def composite_classified(run_ptr, run_start, run_end, run_voxel, sigma, emission_code,
                          normal_code, n_j, order, di, dj, length, emission, factor, highlight,
                          grey, shaded, threshold, band_rows, bands, counter, inter, counts):
-    """Composite the slices ``order`` (front to back) into ``inter[J, I] = (r, g, b, a)``.
+    """Composite the slices ``order`` (front to back) into ``inter[J, I] = (r, g, b, a)``
+    (``grey``: ``(r, a)``, or red and opacity of four channels).
 
     Slice ``k``'s sample for intermediate pixel ``(I, J)`` lies at column ``I + di[k]`` and row
     ``J + dj[k]`` of the slice's ``n_j`` scanlines and stands for a segment of ``length``
@@ -189,6 +190,7 @@ def _composite_band(run_ptr, run_start, run_end, run_voxel, sigma, emission_code
     factor, highlight, inter = borrowed(factor), borrowed(highlight), borrowed(inter)
     links, opaque, taken = borrowed(links), borrowed(opaque), borrowed(taken)
     height, width = inter.shape[0], inter.shape[1]
+    last = inter.shape[2] - 1  # opacity; grey images hold red and opacity alone
     first_row = band * band_rows
     rows = min(band_rows, height - first_row)
     for r in range(rows):
@@ -286,7 +288,7 @@ def _composite_band(run_ptr, run_start, run_end, run_voxel, sigma, emission_code
                         # back (eqs 1.7-1.8).
                         alpha = _opacity(ext * seg)
                         scale = alpha / ext
-                        acc = at(inter, (row, pixel, 3))
+                        acc = at(inter, (row, pixel, last))
                         remaining = 1.0 - acc
                         put(inter, (row, pixel, 0),
                             at(inter, (row, pixel, 0)) + remaining * (cr * scale))
@@ -296,7 +298,7 @@ def _composite_band(run_ptr, run_start, run_end, run_voxel, sigma, emission_code
                             put(inter, (row, pixel, 2),
                                 at(inter, (row, pixel, 2)) + remaining * (cb * scale))
                         acc += remaining * alpha
-                        put(inter, (row, pixel, 3), acc)
+                        put(inter, (row, pixel, last), acc)
                         # Opaque now: linked past. Without a branch: the test waits on
                         # the whole chain of the sample (its exp), and a branch on it
                         # would often be mispredicted, faint samples among opaque ones.

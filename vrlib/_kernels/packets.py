@@ -475,10 +475,10 @@ def _warp_octet_intrinsic(colour):
     False: red alone is interpolated and copied to green and blue) or coloured images."""
 
     @intrinsic
-    def octet(typingctx, src, n_i, n_j, out, at_out, c0, mx, ax, my, ay):
+    def octet(typingctx, src, n_i, n_j, channels, out, at_out, c0, mx, ax, my, ay):
         if not (all(isinstance(a, types.Array) and a.ndim == 1 and a.layout == "C"
                     and a.dtype == types.float64 for a in (src, out)) and out.mutable
-                and all(isinstance(n, types.Integer) for n in (n_i, n_j, at_out, c0))
+                and all(isinstance(n, types.Integer) for n in (n_i, n_j, channels, at_out, c0))
                 and all(isinstance(x, types.Float) for x in (mx, ax, my, ay))):
             return None
 
@@ -499,14 +499,14 @@ def _warp_octet_intrinsic(colour):
                 return _splat(builder, value, ints)
 
             source = context.make_array(sig[0])(context, builder, args[0])
-            image = context.make_array(sig[3])(context, builder, args[3])
-            n_i, n_j = scalar(1), scalar(2)
+            image = context.make_array(sig[4])(context, builder, args[4])
+            n_i, n_j, channels = scalar(1), scalar(2), splat_i(scalar(3))
             # Each lane's pixel column and where its ray meets the intermediate image, as the
             # scalar warp computes them: x = mx c + ax, y = my c + ay.
-            column = builder.add(splat_i(scalar(5)), ir.Constant(ints, list(range(LANES))))
+            column = builder.add(splat_i(scalar(6)), ir.Constant(ints, list(range(LANES))))
             c = builder.sitofp(column, floats)
-            x = builder.fadd(builder.fmul(splat_f(scalar(6)), c), splat_f(scalar(7)))
-            y = builder.fadd(builder.fmul(splat_f(scalar(8)), c), splat_f(scalar(9)))
+            x = builder.fadd(builder.fmul(splat_f(scalar(7)), c), splat_f(scalar(8)))
+            y = builder.fadd(builder.fmul(splat_f(scalar(9)), c), splat_f(scalar(10)))
             zero_f = ir.Constant(floats, [0.0] * LANES)
             one_f = ir.Constant(floats, [1.0] * LANES)
             last_i = splat_f(builder.sitofp(builder.sub(n_i, i64(1)), f64))
@@ -526,9 +526,8 @@ def _warp_octet_intrinsic(colour):
             i, j = cell(x, n_i), cell(y, n_j)
             tx = builder.fsub(x, builder.sitofp(i, floats))
             ty = builder.fsub(y, builder.sitofp(j, floats))
-            row = builder.mul(splat_i(n_i), ir.Constant(ints, [4] * LANES))
-            base = builder.mul(builder.add(builder.mul(j, splat_i(n_i)), i),
-                               ir.Constant(ints, [4] * LANES))
+            row = builder.mul(splat_i(n_i), channels)
+            base = builder.mul(builder.add(builder.mul(j, splat_i(n_i)), i), channels)
             start = splat_i(builder.ptrtoint(source.data, i64))
             gather = cgutils.get_or_insert_function(
                 builder.module,
@@ -537,12 +536,14 @@ def _warp_octet_intrinsic(colour):
                 f"llvm.masked.gather.v{LANES}f64.v{LANES}p0")
 
             def corners(channel):  # (j, i), (j, i + 1), (j + 1, i), (j + 1, i + 1)
-                first = builder.add(base, ir.Constant(ints, [channel] * LANES))
-                right = ir.Constant(ints, [4] * LANES)
+                first = builder.add(base, channel)
                 return [_gather(builder, gather, start, builder.add(first, offset), 8, inside,
                                 floats)
-                        for offset in (ir.Constant(ints, [0] * LANES), right, row,
-                                       builder.add(row, right))]
+                        for offset in (ir.Constant(ints, [0] * LANES), channels, row,
+                                       builder.add(row, channels))]
+
+            def channel_at(index):
+                return ir.Constant(ints, [index] * LANES)
 
             def clipped(value):  # min(max(value, 0.0), 1.0), as numba's min and max select
                 value = builder.select(builder.fcmp_ordered(">", zero_f, value), zero_f, value)
@@ -555,7 +556,7 @@ def _warp_octet_intrinsic(colour):
                 bottom = builder.fadd(builder.fmul(wx, d[2]), builder.fmul(tx, d[3]))
                 return clipped(builder.fadd(builder.fmul(wy, top), builder.fmul(ty, bottom)))
 
-            a = corners(3)
+            a = corners(builder.sub(channels, channel_at(1)))  # opacity: the last channel
             # Transparent where all four neighbours are (colours are premultiplied).
             clear = builder.and_(
                 builder.and_(builder.fcmp_ordered("==", a[0], zero_f),
@@ -563,8 +564,9 @@ def _warp_octet_intrinsic(colour):
                 builder.and_(builder.fcmp_ordered("==", a[2], zero_f),
                              builder.fcmp_ordered("==", a[3], zero_f)))
             seen = builder.and_(inside, builder.not_(clear))
-            red = bilinear(corners(0))
-            green, blue = (bilinear(corners(1)), bilinear(corners(2))) if colour else (red, red)
+            red = bilinear(corners(channel_at(0)))
+            green, blue = ((bilinear(corners(channel_at(1))), bilinear(corners(channel_at(2))))
+                           if colour else (red, red))
             channels = [builder.select(seen, value, zero_f)
                         for value in (red, green, blue, bilinear(a))]
             # Interleaved into the pixels' (r, g, b, a), one store of 4 LANES floats.
@@ -578,12 +580,12 @@ def _warp_octet_intrinsic(colour):
                                2 * LANES + 2 * lane + 1)]
             pixels = builder.shuffle_vector(rg, ba, ir.Constant(
                 ir.VectorType(_I32, 4 * LANES), order))
-            target = builder.gep(image.data, [scalar(4)])
+            target = builder.gep(image.data, [scalar(5)])
             builder.store(pixels, builder.bitcast(
                 target, ir.VectorType(f64, 4 * LANES).as_pointer()), align=8)
             return context.get_dummy_value()
 
-        return types.none(src, n_i, n_j, out, at_out, c0, mx, ax, my, ay), codegen
+        return types.none(src, n_i, n_j, channels, out, at_out, c0, mx, ax, my, ay), codegen
 
     return octet
 

@@ -509,8 +509,9 @@ def _warp_pixel(inter, x, y, out, row, c, grey):
     if x >= 0.0 and y >= 0.0 and x <= n_i - 1 and y <= n_j - 1:
         i = min(int(x), n_i - 2)
         j = min(int(y), n_j - 2)
-        a00, a01 = at(inter, (j, i, 3)), at(inter, (j, i + 1, 3))
-        a10, a11 = at(inter, (j + 1, i, 3)), at(inter, (j + 1, i + 1, 3))
+        last = inter.shape[2] - 1  # opacity
+        a00, a01 = at(inter, (j, i, last)), at(inter, (j, i + 1, last))
+        a10, a11 = at(inter, (j + 1, i, last)), at(inter, (j + 1, i + 1, last))
         if not (a00 == 0.0 and a01 == 0.0 and a10 == 0.0 and a11 == 0.0):
             tx = x - i
             ty = y - j
@@ -537,10 +538,11 @@ def _warp_octet_lanes(inter, src, mx, ax, my, ay, out, flat, row, c, grey):
 def _warp_octet_compiled(inter, src, mx, ax, my, ay, out, flat, row, c, grey):
     at_out = (row * out.shape[1] + c) * 4
     if grey:
-        warp_octet_grey(src, inter.shape[1], inter.shape[0], flat, at_out, c, mx, ax, my, ay)
+        warp_octet_grey(src, inter.shape[1], inter.shape[0], inter.shape[2], flat, at_out, c,
+                        mx, ax, my, ay)
     else:
-        warp_octet_colour(src, inter.shape[1], inter.shape[0], flat, at_out, c, mx, ax, my,
-                          ay)
+        warp_octet_colour(src, inter.shape[1], inter.shape[0], inter.shape[2], flat, at_out,
+                          c, mx, ax, my, ay)
 
 
 warp_octet = _warp_octet_lanes if numba.config.DISABLE_JIT else _warp_octet_compiled
@@ -572,11 +574,11 @@ def seen_box(inter):
     ``(i_lo, i_hi, j_lo, j_hi)`` as floats; ``-3`` each where none does (no column then
     meets the box). Each row is scanned from its two ends inwards, so only the transparent
     margins are read in full."""
-    n_j, n_i = inter.shape[0], inter.shape[1]
+    n_j, n_i, last = inter.shape[0], inter.shape[1], inter.shape[2] - 1  # opacity: last
     i_lo, i_hi, j_lo, j_hi = n_i, -1, n_j, -1
     for j in range(n_j):
         i = 0
-        while i < min(i_lo, n_i) and at(inter, (j, i, 3)) == 0.0:
+        while i < min(i_lo, n_i) and at(inter, (j, i, last)) == 0.0:
             i += 1
         if i == n_i:  # a transparent row
             continue
@@ -584,7 +586,7 @@ def seen_box(inter):
         j_hi = j
         i_lo = min(i_lo, i)
         i = n_i - 1
-        while i > i_hi and at(inter, (j, i, 3)) == 0.0:
+        while i > i_hi and at(inter, (j, i, last)) == 0.0:
             i -= 1
         i_hi = max(i_hi, i)
     if j_hi < 0:
@@ -615,7 +617,7 @@ def warp_rows(inter, m, out, grey, seen, band_rows, counter):
     bilinearly at ``(I, J) = (A, B) / D`` with ``(A, B, D) = m @ (c, r, 1)``, transparent
     outside, or where ``D <= 0`` (the pixel's ray never meets the intermediate image's plane),
     clipped to [0, 1]; ``grey`` images (red, green and blue equal) interpolate one colour
-    channel.
+    channel, and may hold red and opacity alone (two channels: opacity is the last).
 
     An affine ``m`` (orthographic views: ``D = 1``) takes no division and visits only the
     columns that can meet the intermediate image's non-transparent box ``seen = (i_lo, i_hi,
