@@ -96,7 +96,7 @@ def _slice_shape(volume, axis):
 
 @functools.cache
 def _normals():
-    return decode_normals()
+    return np.ascontiguousarray(decode_normals().T)  # rows of x, y and z components
 
 
 def classify(volume, transfer=None, *, min_opacity=0.0):
