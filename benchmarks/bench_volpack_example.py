@@ -12,9 +12,9 @@ VolPack classifies and shades it itself (``vpVolumeNormals``, ``vpClassifyVolume
 two changes made so that both render one scene: two-sided lighting, no depth cueing). vrlib
 renders the same classification with :func:`vrlib.classify` (density ramp as opacity per
 voxel spacing, gradient ramp as a :class:`vrlib.GradientOpacity`). Both are timed per frame
-(the median over the turning frames, best of three sweeps) in this process; errors are
-against a fine ray cast of vrlib's transfer function (Catmull-Rom, 1/8 voxel steps, no early
-termination: :func:`vrlib.reference_image`), on the luminance.
+(the median over the turning frames, best of five sweeps taken in turns) in this process;
+errors are against a fine ray cast of vrlib's transfer function (Catmull-Rom, 1/8 voxel
+steps, no early termination: :func:`vrlib.reference_image`), on the luminance.
 """
 
 from __future__ import annotations
@@ -66,16 +66,29 @@ def brain_scene(density, model):
     return volume, transfer, view
 
 
+#: Sweeps of the turning frames per renderer, taken in turns (see :func:`sweeps`).
+ROUNDS = 5
+
+
 def sweep(render_frame):
-    """Median seconds per frame over the turning frames, best of three sweeps."""
-    best = np.inf
-    for _ in range(3):
-        times = []
-        for turn in TURNS:
-            start = time.perf_counter()
-            render_frame(turn)
-            times.append(time.perf_counter() - start)
-        best = min(best, float(np.median(times)))
+    """Median seconds per frame over the turning frames."""
+    times = []
+    for turn in TURNS:
+        start = time.perf_counter()
+        render_frame(turn)
+        times.append(time.perf_counter() - start)
+    return float(np.median(times))
+
+
+def sweeps(renderers):
+    """``{name: seconds per frame}``, the best of :data:`ROUNDS` sweeps each, the renderers
+    taking turns sweep by sweep: a machine that slows for a while (another tenant, the
+    clock) slows every renderer's sweeps alike instead of one renderer's, and the ratios
+    are taken within one run."""
+    best = {name: np.inf for name in renderers}
+    for _ in range(ROUNDS):
+        for name, render_frame in renderers.items():
+            best[name] = min(best[name], sweep(render_frame))
     return best
 
 
@@ -112,10 +125,10 @@ def main():
         vp.render()
 
     rows, record = [], {"frames": len(TURNS), "size": IMAGE_SIZE, "rows": []}
-    times = {"VolPack (1 thread)": sweep(volpack_frame),
-             "vrlib classified, 1 thread": sweep(lambda t: vrlib_frame(t, 1)),
-             "vrlib classified, 2 threads": sweep(lambda t: vrlib_frame(t, 2)),
-             EXACT: sweep(lambda t: vrlib_frame(t, 2, exact, 0.999))}
+    times = sweeps({"VolPack (1 thread)": volpack_frame,
+                    "vrlib classified, 1 thread": lambda t: vrlib_frame(t, 1),
+                    "vrlib classified, 2 threads": lambda t: vrlib_frame(t, 2),
+                    EXACT: lambda t: vrlib_frame(t, 2, exact, 0.999)})
     # Errors on three of the frames, against the fine ray cast of vrlib's transfer function.
     errors = {name: [] for name in times}
     for turn in TURNS[::12]:
