@@ -31,6 +31,9 @@ def thread_count(threads):
     if not 1 <= threads <= limit:
         raise ValueError(f"threads must be between 1 and {limit}, got {threads}")
     previous = numba.get_num_threads()
+    if previous == threads:  # nothing to set or restore (each costs microseconds)
+        yield
+        return
     numba.set_num_threads(int(threads))
     try:
         yield

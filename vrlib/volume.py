@@ -206,6 +206,9 @@ class Volume:
         arr.flags.writeable = False
         self._data = arr
         self._extent = _world_box(arr.shape, extent, spacing, origin)
+        self._extent.flags.writeable = False
+        counts = np.array(arr.shape[::-1], dtype=np.float64) - 1.0
+        self._spacing = (self._extent[:, 1] - self._extent[:, 0]) / counts
         self._derived = {}  # cached structures built from the samples (pyramids, runs)
 
     # -- lattice geometry ------------------------------------------------------------------
@@ -249,9 +252,8 @@ class Volume:
 
     @property
     def spacing(self):
-        """World distance between neighbouring samples along ``(x, y, z)``."""
-        counts = np.array(self.shape[::-1], dtype=np.float64) - 1.0
-        return (self._extent[:, 1] - self._extent[:, 0]) / counts
+        """World distance between neighbouring samples along ``(x, y, z)`` (a copy)."""
+        return self._spacing.copy()
 
     @property
     def center(self):
