@@ -45,8 +45,9 @@ def shade_table(normals, light, direction, ka, kd, ks, shininess, factor, highli
     count = factor.shape[0]
     for n in range(count):
         norm = math.sqrt(gx[n] * gx[n] + gy[n] * gy[n] + gz[n] * gz[n])
-        lit = abs(gx[n] * lx + gy[n] * ly + gz[n] * lz) / norm
-        half = abs(gx[n] * hx + gy[n] * hy + gz[n] * hz) / norm
+        scale = norm if norm > 0.0 else 1.0  # the zero normal: lit as if facing the light
+        lit = abs(gx[n] * lx + gy[n] * ly + gz[n] * lz) / scale
+        half = abs(gx[n] * hx + gy[n] * hy + gz[n] * hz) / scale
         factor[n] = ka + kd * (lit if norm > 0.0 else 1.0)
         highlight[n] = half if norm > 0.0 else 1.0
     # ks |n.h|^shininess: power's squaring, one step for every code at a time.
