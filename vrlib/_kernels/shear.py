@@ -547,9 +547,8 @@ def _warp_octet_compiled(inter, src, mx, ax, my, ay, out, flat, row, c, grey):
 
 warp_octet = _warp_octet_lanes if numba.config.DISABLE_JIT else _warp_octet_compiled
 """``warp_octet(inter, src, mx, ax, my, ay, out, flat, row, c, grey)``: pixels
-``c .. c + LANES - 1``
-of row ``row`` of the affine warp (:func:`warp_rows`; pixel ``c`` samples ``inter`` at
-``(mx c + ax, my c + ay)``) at once, in vector form
+``c .. c + LANES - 1`` of row ``row`` of the affine warp (:func:`warp_rows`; pixel ``c``
+samples ``inter`` at ``(mx c + ax, my c + ay)``) at once, in vector form
 (:func:`vrlib._kernels.packets.warp_octet_grey` and ``_colour``): :func:`_warp_pixel`'s
 arithmetic lane by lane, so the image is the same bit for bit. ``inter`` and ``out``
 C-contiguous, ``src`` and ``flat`` their raveled views."""
