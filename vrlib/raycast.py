@@ -301,10 +301,11 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
     # Cost of a tile: the pixels whose rays can meet something visible; the threads take the
     # heaviest tiles first. Tiles without such a pixel stay transparent and are not handed
     # out at all.
-    padded = np.zeros((rows * TILE[0], cols * TILE[1]), np.int32)
+    padded = np.zeros((rows * TILE[0], cols * TILE[1]), np.uint8)
     padded[: view.height, : view.width] = skip[3]
-    costs = padded.reshape(rows, TILE[0], cols * TILE[1]).sum(axis=1)  # a tile's rows
-    costs = costs.reshape(rows, cols, TILE[1]).sum(axis=2).ravel()  # then its columns
+    costs = np.add.reduce(padded.reshape(rows, TILE[0], cols * TILE[1]), axis=1,
+                          dtype=np.int32)  # a tile's rows, then its columns
+    costs = np.add.reduce(costs.reshape(rows, cols, TILE[1]), axis=2).ravel()
     live = np.flatnonzero(costs)
     # One array type per argument (read-only samples, contiguous vectors): every other
     # combination would compile the kernel once more.
@@ -346,5 +347,4 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
         lanes = _kernel.lanes(threads)
         on_threads(lambda i: _kernel.raycast(*arguments, scratch[i], *(a[i] for a in lanes)),
                    threads)
-    np.clip(out[..., 3], 0.0, 1.0, out=out[..., 3])
-    return out, int(samples.sum())
+    return out, int(samples.sum())  # the kernels clip each pixel's opacity

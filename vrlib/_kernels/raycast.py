@@ -184,11 +184,12 @@ def _inside(k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in, t_out):
 
 @jit(inline="always")
 def _put_pixel(out, r, c, red, green, blue, alpha):
-    """A ray's colour and opacity into its pixel."""
+    """A ray's colour and opacity into its pixel, the opacity clipped to [0, 1] (rounding
+    can carry a sum of segments a unit in the last place past 1)."""
     out[r, c, 0] = red
     out[r, c, 1] = green
     out[r, c, 2] = blue
-    out[r, c, 3] = alpha
+    out[r, c, 3] = min(max(alpha, 0.0), 1.0)
 
 
 @jit(inline="always")
@@ -567,10 +568,7 @@ def raycast_preintegrated(data, offset, gshape, origin, spacing, box_lo, box_hi,
                     col_start, col_inv, pre_mean, shade, ka, kd, ks, shininess, light, headlight,
                     ramp_x, ramp_y, by_gradient, threshold, empty, clearance, block, fine_counts,
                     bound, budget, wx, wy, wz, dx, dy, dz)
-            out[r, c, 0] = rgba[0]
-            out[r, c, 1] = rgba[1]
-            out[r, c, 2] = rgba[2]
-            out[r, c, 3] = rgba[3]
+            _put_pixel(out, r, c, rgba[0], rgba[1], rgba[2], rgba[3])
             taken += rgba[4]
         samples[tile_id] = taken
 
