@@ -20,6 +20,7 @@ from typing import NamedTuple
 import numpy as np
 
 from vrlib.value_bounds import value_bounds
+from vrlib.view import BOX_CORNERS
 
 __all__ = ["BLOCK", "SkipGrid", "skip_grid", "block_densities", "empty_blocks",
            "brick_empty_blocks", "clearance", "visible_box", "footprint_mask",
@@ -209,10 +210,9 @@ def footprint_mask(view, lattice, empty, block):
     full = np.argwhere(~empty)[:, ::-1]  # block indices, x y z
     if full.size == 0:
         return np.zeros(view.shape, dtype=bool)
-    corners = np.array(np.meshgrid([0, 1], [0, 1], [0, 1], indexing="ij")).reshape(3, -1).T
     # Corner-major, (8, blocks, 3): numpy reduces over a leading axis of 8 far faster than
     # over a trailing one.
-    cells = (corners[:, None, :] + full[None, :, :]) * block
+    cells = (BOX_CORNERS[:, None, :] + full[None, :, :]) * block
     cells = np.minimum(cells, np.array(lattice.shape[::-1]) - 1)
     projected = view.project(lattice.origin + cells * lattice.spacing)
     if not np.all(np.isfinite(projected)) or np.any(projected[..., 2] <= 0.0):

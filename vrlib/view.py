@@ -226,7 +226,7 @@ class View:
         (True, False)
         """
         box = np.asarray(extent, dtype=np.float64)
-        corners = box[_AXES, _CORNERS]  # (8, 3): x, y, z each at its low or high end
+        corners = box[_AXES, BOX_CORNERS]  # (8, 3): x, y, z each at its low or high end
         if self.is_perspective:
             depth = self.to_camera(corners)[:, 2]
             if np.all(depth <= 0.0):
@@ -404,8 +404,8 @@ class View:
         )
 
 
-#: The eight corners of a box, as the end (0 low, 1 high) each axis takes.
-_CORNERS = np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)])
+#: The eight corners of a box, ``(8, 3)``: the end (0 low, 1 high) each axis takes.
+BOX_CORNERS = np.array([[i, j, k] for i in (0, 1) for j in (0, 1) for k in (0, 1)])
 _AXES = np.arange(3)
 
 
