@@ -48,7 +48,7 @@ def _line_taps(fkind, fp0, fp1, fp2, radius, ntaps, pos, w):
 def _resample(src, s, r, lo, hi, pos, fkind, fp0, fp1, fp2, radius, ntaps, w):
     """Line ``src[s, r]`` (data on ``lo .. hi``) reconstructed at ``pos``; taps clamped to the
     data only near its ends."""
-    first = _line_taps(fkind, fp0, fp1, fp2, radius, ntaps, pos, w)
+    first = _line_taps(fkind, fp0, fp1, fp2, radius, ntaps, pos, borrowed(w))
     return _taps_sum(src, s, r, lo, hi, first, ntaps, w)
 
 
@@ -189,6 +189,14 @@ def _inside_range(inverse, shift, limits, x, y, n):
     return max(0, int(math.floor(z_lo)) - 1), min(n - 1, int(math.ceil(z_hi)) + 1)
 
 
+@jit(inline="always")
+def _lit_views(alpha_tab, emit_tab, lit, ramp_x, ramp_y, buf):
+    """The arrays :func:`_over_lit` takes, borrowed (:data:`~vrlib._kernels._jit.borrowed`):
+    a call per sample would otherwise count references to each of them."""
+    return (borrowed(alpha_tab), borrowed(emit_tab), borrowed(lit), borrowed(ramp_x),
+            borrowed(ramp_y), borrowed(buf))
+
+
 @helper_jit
 def _over_lit(value, fraction, gx, gy, gz, tstart, tinv, alpha_tab, emit_tab, lit, ramp_x,
               ramp_y, buf, y, x, dx, dy, dz):
@@ -236,6 +244,8 @@ def resample_composite(src, c0, c1, c2, offset, line_lo, line_hi, fkind, fp0, fp
     height, width = out.shape[0], out.shape[1]
     n = src.shape[2]
     lighting = lit[0] != 0.0 or lit[2] != 0.0  # shading or gradient opacity
+    alpha_tab, emit_tab, lit, ramp_x, ramp_y, out = _lit_views(alpha_tab, emit_tab, lit,
+                                                               ramp_x, ramp_y, out)
     for row_index in prange(height):
         y = np.int64(row_index)
         w = np.empty(MAX_TAPS)
@@ -279,7 +289,7 @@ def resample_composite(src, c0, c1, c2, offset, line_lo, line_hi, fkind, fp0, fp
                     lo = max(0, line_lo[y, x])
                     hi = min(n - 1, line_hi[y, x])
                     first = _line_taps(fkind, fp0, fp1, fp2, radius, ntaps,
-                                       (z - (offset + c1 * x + c2 * y)) / c0, w)
+                                       (z - (offset + c1 * x + c2 * y)) / c0, borrowed(w))
                     value = _taps_sum(src, y, x, lo, hi, first, ntaps, w)
                     if lighting:
                         gx = _taps_sum(grads[0], y, x, lo, hi, first, ntaps, w)
@@ -310,6 +320,8 @@ def composite_slices(vol, front_to_back, inverse2, shift, limits, tstart, tinv, 
     classified by their gradient too (:func:`_over_lit`)."""
     n_w, height, width = vol.shape
     lighting = lit[0] != 0.0 or lit[2] != 0.0  # shading or gradient opacity
+    alpha_tab, emit_tab, lit, ramp_x, ramp_y, out = _lit_views(alpha_tab, emit_tab, lit,
+                                                               ramp_x, ramp_y, out)
     for row_index in prange(height):
         y = np.int64(row_index)
         w_first = np.empty(width, np.int64)
@@ -395,6 +407,9 @@ def shear_slices(slices, order, scale, di, dj, fraction, fkind, fp0, fp1, fp2, r
     n_k, n_j, n_i = slices.shape
     height, width = inter.shape[0], inter.shape[1]
     uniform = fraction.shape[0] == 1
+    alpha_tab, emit_tab, lit, ramp_x, ramp_y, inter = _lit_views(alpha_tab, emit_tab, lit,
+                                                                 ramp_x, ramp_y, inter)
+    slices, grads = borrowed(slices), borrowed(grads)
     for row in prange(height):
         big_j = np.int64(row)
         wi = np.empty(8)
@@ -439,15 +454,19 @@ def shear_slices(slices, order, scale, di, dj, fraction, fkind, fp0, fp1, fp2, r
                     i0 = int(math.floor(i - radius)) + 1
                     for a in range(ntaps):
                         wi[a] = weight(fkind, fp0, fp1, fp2, i - (i0 + a))
-                value = _slice_sum(slices, k, rows, i0, ntaps, wi, wj)
+                value = _slice_sum(slices, k, borrowed(rows), i0, ntaps, borrowed(wi),
+                                   borrowed(wj))
                 done += 1
                 part = end if uniform else end * fraction[big_j, big_i]
                 if lighting:
                     # Perspective: each intermediate pixel's own ray direction.
                     ray_j, ray_i = (0, 0) if rays.shape[0] == 1 else (big_j, big_i)
-                    _over_lit(value, part, _slice_sum(grads[0], k, rows, i0, ntaps, wi, wj),
-                              _slice_sum(grads[1], k, rows, i0, ntaps, wi, wj),
-                              _slice_sum(grads[2], k, rows, i0, ntaps, wi, wj), tstart, tinv,
+                    _over_lit(value, part, _slice_sum(grads[0], k, borrowed(rows), i0, ntaps,
+                                                      borrowed(wi), borrowed(wj)),
+                              _slice_sum(grads[1], k, borrowed(rows), i0, ntaps, borrowed(wi),
+                                         borrowed(wj)),
+                              _slice_sum(grads[2], k, borrowed(rows), i0, ntaps, borrowed(wi),
+                                         borrowed(wj)), tstart, tinv,
                               alpha_tab, emit_tab, lit, ramp_x, ramp_y, inter, big_j, big_i,
                               rays[ray_j, ray_i, 0], rays[ray_j, ray_i, 1],
                               rays[ray_j, ray_i, 2])
@@ -468,6 +487,7 @@ def project_slices(slices, order, scale, di, dj, fkind, fp0, fp1, fp2, radius, n
     thread count."""
     n_k, n_j, n_i = slices.shape
     height, width = value.shape[0], value.shape[1]
+    slices = borrowed(slices)
     for row in prange(height):
         wi = np.empty(8)
         wj = np.empty(8)
@@ -478,20 +498,22 @@ def project_slices(slices, order, scale, di, dj, fkind, fp0, fp1, fp2, radius, n
             j = s * row + dj[k]
             if j < 0.0 or j > n_j - 1:
                 continue
-            j_first = filter_taps(fkind, fp0, fp1, fp2, radius, ntaps, j, wj)
+            j_first = filter_taps(fkind, fp0, fp1, fp2, radius, ntaps, j, borrowed(wj))
             for b in range(ntaps):
                 rows[b] = clamp(j_first + b, n_j)
             big_first = max(0, int(math.ceil(-di[k] / s)))
             big_last = min(width - 1, int(math.floor((n_i - 1.0 - di[k]) / s)))
             # Orthographic: one fractional offset per slice, one set of weights for it all.
             shared = s == 1.0
-            tap0 = filter_taps(fkind, fp0, fp1, fp2, radius, ntaps, di[k], wi) if shared else 0
+            tap0 = (filter_taps(fkind, fp0, fp1, fp2, radius, ntaps, di[k], borrowed(wi))
+                    if shared else 0)
             for big_i in range(big_first, big_last + 1):
                 if shared:
                     i0 = big_i + tap0
                 else:
-                    i0 = filter_taps(fkind, fp0, fp1, fp2, radius, ntaps, s * big_i + di[k], wi)
-                v = _slice_sum(slices, k, rows, i0, ntaps, wi, wj)
+                    i0 = filter_taps(fkind, fp0, fp1, fp2, radius, ntaps, s * big_i + di[k],
+                                     borrowed(wi))
+                v = _slice_sum(slices, k, borrowed(rows), i0, ntaps, borrowed(wi), borrowed(wj))
                 if not maximum:
                     value[row, big_i] += v
                 elif count[row, big_i] == 0 or v > value[row, big_i]:
