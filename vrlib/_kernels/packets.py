@@ -254,14 +254,27 @@ def _inside_runs_intrinsic(colour):
             builder.cbranch(builder.call(any_lane, [active0]), loop, done)
 
             builder.position_at_end(loop)
+            # Two counts per lane. ``k`` is the lane's own: it stops where the ray turns
+            # opaque (what the scalar loop leaves). ``reach`` is the sample the loads take:
+            # it runs on to the run's end whatever the compositing found, so that no load
+            # waits on the sample before it (the opacity test closed the chain from one
+            # sample's loads to the next's; the loads of several samples now overlap). A
+            # lane that has turned opaque loads on, inside its run, while other lanes
+            # composite; what it loads is not used.
             k = builder.phi(ints)
-            active = builder.phi(masks)
+            reach = builder.phi(ints)
+            live = builder.phi(masks)  # reach < end
+            clear = builder.phi(masks)  # not yet opaque
             acc = [builder.phi(floats) for _ in range(4)]
-            for phi, start in zip((k, active, *acc), (k0, active0, *acc0), strict=True):
+            for phi, start in zip((k, reach, live, clear, *acc),
+                                  (k0, k0, active0, ir.Constant(masks, [1] * LANES), *acc0),
+                                  strict=True):
                 phi.add_incoming(start, before)
+            active = builder.and_(live, clear)
             # The sample's index position (the lattice: a + ((k + 1/2) ds) b), its cell and
             # fractions (floor: positions inside the volume are >= 0).
-            t = builder.fmul(builder.fadd(builder.sitofp(k, floats), constant(0.5, floats)), ds)
+            t = builder.fmul(builder.fadd(builder.sitofp(reach, floats), constant(0.5, floats)),
+                             ds)
             u = [builder.fadd(a, builder.fmul(t, b)) for a, b in ((ax, bx), (ay, by), (az, bz))]
             cell = [builder.fptosi(value, ints) for value in u]
             tx, ty, tz = (builder.fsub(u[axis], builder.sitofp(cell[axis], floats))
@@ -273,13 +286,13 @@ def _inside_runs_intrinsic(colour):
 
             def corner(offset):
                 return _gather(builder, gather_volume, volume_start, builder.add(base, offset),
-                               size, active, stored_vector)
+                               size, live, stored_vector)
 
             # Ask for the cells of the samples PREFETCH_AHEAD steps on: four cache lines a
             # lane (the cell's two rows in its two planes). A ray's next cells lie on new
             # lines that no hardware prefetcher foresees; without this, a packet waits for
             # memory at each (256^3 float32: 105 against 145 M samples/s on one thread).
-            ahead_k = builder.sitofp(builder.add(k, constant(PREFETCH_AHEAD, ints)), floats)
+            ahead_k = builder.sitofp(builder.add(reach, constant(PREFETCH_AHEAD, ints)), floats)
             ahead_t = builder.fmul(builder.fadd(ahead_k, constant(0.5, floats)), ds)
             ahead = builder.sub(builder.add(builder.add(
                 builder.mul(builder.fptosi(builder.fadd(az, builder.fmul(ahead_t, bz)), ints),
@@ -316,7 +329,7 @@ def _inside_runs_intrinsic(colour):
                 d = []
                 for offset in (zero_i, row_step, plane_step, both):
                     pair = _gather(builder, gather_pairs, volume_start, builder.add(base, offset),
-                                   size, active, ir.VectorType(i64, LANES))
+                                   size, live, ir.VectorType(i64, LANES))
                     split = builder.bitcast(pair, halves)
                     d.append(builder.shuffle_vector(split, ir.Constant(halves, None), even))
                     d.append(builder.shuffle_vector(split, ir.Constant(halves, None), odd))
@@ -344,8 +357,8 @@ def _inside_runs_intrinsic(colour):
                 beyond, one_f, builder.fsub(x, builder.sitofp(floor, floats))), zero_f)
             next_row = builder.add(row, one_i)
 
-            left = _gather(builder, gather_table, alpha_start, row, 8, active, floats)
-            right = _gather(builder, gather_table, alpha_start, next_row, 8, active, floats)
+            left = _gather(builder, gather_table, alpha_start, row, 8, live, floats)
+            right = _gather(builder, gather_table, alpha_start, next_row, 8, live, floats)
             alpha = builder.fadd(left, builder.fmul(weight, builder.fsub(right, left)))
             # Front to back over (eqs 1.7-1.8) where the segment is not transparent.
             take = builder.and_(active, builder.fcmp_ordered(">", alpha, zero_f))
@@ -357,9 +370,9 @@ def _inside_runs_intrinsic(colour):
                     start = builder.add(color_start, _splat(
                         builder, builder.mul(color_column, i64(channel)), ints))
                     lo = _gather(builder, gather_table, start, builder.mul(row, color_row), 1,
-                                 active, floats, 8)
+                                 live, floats, 8)
                     hi = _gather(builder, gather_table, start,
-                                 builder.mul(next_row, color_row), 1, active, floats, 8)
+                                 builder.mul(next_row, color_row), 1, live, floats, 8)
                     colours.append(builder.fadd(lo, builder.fmul(weight, builder.fsub(hi, lo))))
                 over = [builder.fadd(acc[c], builder.fmul(remaining, colours[c]))
                         for c in range(3)]
@@ -371,12 +384,15 @@ def _inside_runs_intrinsic(colour):
                                                                            strict=True)]
             k_next = builder.select(active, builder.add(k, one_i), k)
             opaque = builder.and_(take, builder.fcmp_ordered(">=", acc_next[3], threshold))
-            active_next = builder.and_(builder.and_(active, builder.icmp_signed("<", k_next, end)),
-                                       builder.not_(opaque))
-            for phi, value in zip((k, active, *acc), (k_next, active_next, *acc_next),
+            clear_next = builder.and_(clear, builder.not_(opaque))
+            reach_next = builder.select(live, builder.add(reach, one_i), reach)
+            live_next = builder.and_(live, builder.icmp_signed("<", reach_next, end))
+            for phi, value in zip((k, reach, live, clear, *acc),
+                                  (k_next, reach_next, live_next, clear_next, *acc_next),
                                   strict=True):
                 phi.add_incoming(value, loop)
-            builder.cbranch(builder.call(any_lane, [active_next]), loop, done)
+            builder.cbranch(builder.call(any_lane, [builder.and_(live_next, clear_next)]), loop,
+                            done)
 
             builder.position_at_end(done)
             results = []
