@@ -64,22 +64,33 @@ def test_vectorised_max_density_matches_scalar():
         assert m == pytest.approx(tf.opacity_density(np.linspace(a, b, 20001)).max(), abs=1e-3)
 
 
+@pytest.mark.parametrize("through", [True, False])
 @pytest.mark.parametrize("seed", range(4))
-def test_clearance_is_the_distance_to_the_other_kind(seed):
-    """A ray jumps (or samples unchecked) across the cube of 2|d| - 1 blocks around a block of
-    clearance d: every block of that cube must be of the block's kind, and one at distance |d|
-    must not be (else the jump would be shorter than it could be). Brute force on random
-    grids, sparse to dense, and the grids of one kind only."""
+def test_clearance_is_how_far_a_ray_may_go_unchecked(seed, through):
+    """A ray jumps (empty) or samples unchecked (not empty) across the cube of 2|d| - 1
+    blocks around a block of clearance d. An empty block's cube must hold only empty blocks;
+    a non-empty block's no deep empty block (one two or more blocks from any non-empty
+    block: there a jump would pay; with ``through=False`` no empty block at all). And the
+    cube must be as large as that allows: a block of the kind that stops it lies at distance
+    |d|. Brute force on random grids, sparse to dense, and the grids of one kind only."""
     rng = np.random.default_rng(seed)
     empty = rng.random((5, 7, 6)) < (0.3, 0.7, 0.95, 0.99)[seed]
-    reach = clearance(empty)
+    reach = clearance(empty, through=through)
     index = np.indices(empty.shape).reshape(3, -1).T
-    for here in index:
+    flat = empty.reshape(-1)
+    full_at = index[~flat]
+    away = np.array([np.abs(full_at - here).max(axis=1).min() if here_empty else 0
+                     for here, here_empty in zip(index, flat, strict=True)])
+    deep = away >= (2 if through else 1)
+    for n, here in enumerate(index):
         distance = np.abs(index - here).max(axis=1)
-        other = empty.reshape(-1) != empty[tuple(here)]
+        stops = ~flat if flat[n] else deep
         d = reach[tuple(here)]
-        assert (d > 0) == empty[tuple(here)]
-        assert distance[other].min() == abs(d)
+        assert (d > 0) == flat[n]
+        if stops.any():
+            assert distance[stops].min() == abs(d)
+        else:
+            assert abs(d) == max(empty.shape)
     assert (clearance(np.ones((2, 3, 4), bool)) == 4).all()
     assert (clearance(np.zeros((2, 3, 4), bool)) == -4).all()
 

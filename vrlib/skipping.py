@@ -38,7 +38,7 @@ class SkipGrid(NamedTuple):
     densities: np.ndarray
     #: Whether nothing in the block shows (its density is 0).
     empty: np.ndarray
-    #: The Chebyshev distance to the nearest block of the other kind (:func:`clearance`).
+    #: How far a ray may go from each block before it looks again (:func:`clearance`).
     clearance: np.ndarray
 
 
@@ -153,17 +153,32 @@ def brick_empty_blocks(data, first, lo, hi, cells, filt, transfer, *, block=BLOC
     return empty
 
 
-def clearance(empty):
-    """Per block, the Chebyshev distance (in blocks) to the nearest block of the other kind:
-    positive for an empty block, negative for one that is not. Every block within ``|d| - 1``
-    blocks of a block at distance ``d`` is of its kind, so a ray can cross the whole cube of
-    ``2 |d| - 1`` blocks a side around it at once, jumping (empty) or sampling without a
-    check (not empty). Where every block is of one kind, the grid's largest extent.
+def clearance(empty, *, through=True):
+    """Per block, how far a ray may go from it before it looks at the grid again, as a
+    Chebyshev distance in blocks.
+
+    * An empty block gets the distance ``d > 0`` to the nearest block that is not empty:
+      every block within ``d - 1`` of it is empty, so a ray jumps the whole cube of
+      ``2 d - 1`` blocks a side around it at once.
+    * A block that is not empty gets ``-d``, ``d`` the distance to the nearest *deep* empty
+      block (one at least two blocks from any that is not empty): every block within
+      ``d - 1`` of it is either not empty or an empty block next to one that is, and a ray
+      samples across that cube without a check. The empty blocks it then samples add
+      exactly nothing (their values classify to zero opacity); a jump from one of them would
+      cross that one block only, and stopping a run of samples to make it cost more than its
+      samples (six sparse blobs and MNI152 at 512^2: 1.1 to 1.2 times faster, the same
+      images). With ``through=False``, the distance to the nearest empty block instead: the
+      ray samples only non-empty blocks (the MPI renderers, whose work-sized split balances
+      the samples of visible blocks).
+
+    Where no block is of the kind looked for, the grid's largest extent.
 
     Examples
     --------
     >>> empty = np.ones((1, 1, 7), dtype=bool); empty[0, 0, 1:3] = False
     >>> clearance(empty)
+    array([[[ 1, -3, -2,  1,  2,  3,  4]]])
+    >>> clearance(empty, through=False)
     array([[[ 1, -1, -1,  1,  2,  3,  4]]])
     """
     from scipy.ndimage import distance_transform_cdt
@@ -171,8 +186,12 @@ def clearance(empty):
     reach = np.full(empty.shape, max(empty.shape), dtype=np.int64)
     if empty.all() or not empty.any():
         return reach if empty.all() else -reach
-    return (distance_transform_cdt(empty, metric="chessboard")
-            - distance_transform_cdt(~empty, metric="chessboard")).astype(np.int64)
+    away = distance_transform_cdt(empty, metric="chessboard")  # 0 where not empty
+    deep = away >= 2 if through else away >= 1
+    if not deep.any():
+        return np.where(empty, away, -reach).astype(np.int64)
+    return np.where(empty, away,
+                    -distance_transform_cdt(~deep, metric="chessboard")).astype(np.int64)
 
 
 def visible_box(volume, empty, block, lo, hi):

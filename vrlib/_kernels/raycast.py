@@ -265,8 +265,9 @@ def _skip(k, ux, uy, uz, ax, ay, az, bx, by, bz, ds, by_front, empty, clearance,
     in a block that is not empty is stepped back over: the image is unchanged. By its front
     end, only the segments that also end inside an empty block are jumped, so that the whole
     run lies in one empty box. In a block that is not empty, ``t_check`` is where the ray
-    leaves the cube of such blocks around it (taking a sample that lies in an empty block
-    adds exactly nothing), or the block itself with a ``budget`` or when ``blockwise``
+    leaves the cube around it that its clearance gives (blocks that are not empty, and
+    empty ones beside them: a sample that lies in an empty block adds exactly nothing), or
+    the block itself with a ``budget`` or when ``blockwise``
     (adaptive steps: a step per block). With a budget, a block that is not empty is left out
     while the bounds of what the ray has left out stay within ``budget`` (``spent`` so
     far)."""
@@ -278,7 +279,8 @@ def _skip(k, ux, uy, uz, ax, ay, az, bx, by, bz, ds, by_front, empty, clearance,
             t_exit = _exit(ax, ay, az, bx, by, bz, block, fine_counts, ux, uy, uz,
                            np.int64(1))
         else:
-            # Every block within the clearance is not empty: sample on to the cube's face.
+            # No block within the clearance is one to jump from: sample on to the cube's
+            # face.
             t_exit = _exit(ax, ay, az, bx, by, bz, block, fine_counts, ux, uy, uz, -reach)
         if budget > 0.0:
             cost = _block_bound(bound, block, ux, uy, uz)
@@ -612,9 +614,9 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
     threads nor on which thread took which tile.
 
     Skips: ``empty`` flags blocks of ``block`` cells per axis that nothing visible can come
-    from, and ``clearance`` (per block, an integer array of the same shape) the Chebyshev
-    distance in blocks to the nearest block that is not empty (``block = 0`` turns skipping
-    off), and ``mask`` the pixels whose rays can meet a non-empty block; ``threshold = 1``
+    from, and ``clearance`` (per block, an integer array of the same shape) how far a ray
+    may go from the block unchecked, in blocks (:func:`vrlib.skipping.clearance`; ``block =
+    0`` turns skipping off), and ``mask`` the pixels whose rays can meet a non-empty block; ``threshold = 1``
     turns early ray termination off. With ``budget > 0`` a ray also skips blocks that are not
     empty while the bounds ``bound`` (per block: the most a ray can change any channel by
     leaving the block out) of the blocks it skipped add up to at most ``budget``: each pixel

@@ -99,7 +99,9 @@ def _cast(data, first, brick_lo, brick_hi, lattice, view, filt, transfer, ds, va
     return cast_rays(data, offset=tuple(first), global_shape=lattice.shape,
                      origin=lattice.origin, spacing=lattice.spacing, box=box, view=view,
                      filt=filt, transfer=transfer, ds=ds, value_range=value_range,
-                     early_termination=1.0, skip=(empty, clearance(empty), BLOCK, mask),
+                     early_termination=1.0,
+                     # Only non-empty blocks sampled: the work-sized split balances them.
+                     skip=(empty, clearance(empty, through=False), BLOCK, mask),
                      exact_ends=exact_ends, preintegrated=preintegrated)
 
 
@@ -394,7 +396,8 @@ def render_image(comm, source, view, *, shape=None, extent=None, filter="triline
                 local, offset=tuple(lo), global_shape=lattice.shape, origin=lattice.origin,
                 spacing=lattice.spacing, box=lattice.box((0, 0, 0), lattice.cells), view=view,
                 filt=filt, transfer=transfer, ds=ds, value_range=value_range,
-                early_termination=1.0, skip=(skip_grid, clearance(skip_grid), BLOCK, mask),
+                early_termination=1.0,
+                skip=(skip_grid, clearance(skip_grid, through=False), BLOCK, mask),
                 exact_ends=exact, preintegrated=preint)
         render_s = time.perf_counter() - start
     rgba = gather_to_root(comm, [(r, rects.pixels(rgba, r)) for r in mine], view.shape, root,
