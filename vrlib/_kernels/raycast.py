@@ -616,11 +616,11 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
     Skips: ``empty`` flags blocks of ``block`` cells per axis that nothing visible can come
     from, and ``clearance`` (per block, an integer array of the same shape) how far a ray
     may go from the block unchecked, in blocks (:func:`vrlib.skipping.clearance`; ``block =
-    0`` turns skipping off), and ``mask`` the pixels whose rays can meet a non-empty block; ``threshold = 1``
-    turns early ray termination off. With ``budget > 0`` a ray also skips blocks that are not
-    empty while the bounds ``bound`` (per block: the most a ray can change any channel by
-    leaving the block out) of the blocks it skipped add up to at most ``budget``: each pixel
-    changes by at most ``budget``.
+    0`` turns skipping off), and ``mask`` the pixels whose rays can meet a non-empty block;
+    ``threshold = 1`` turns early ray termination off. With ``budget > 0`` a ray also skips
+    blocks that are not empty while the bounds ``bound`` (per block: the most a ray can
+    change any channel by leaving the block out) of the blocks it skipped add up to at most
+    ``budget``: each pixel changes by at most ``budget``.
     Adaptive steps: where ``multiplier`` (per block of the skip grid, a power of two; a
     ``(1, 1, 1)`` array of 1 turns them off) exceeds 1, one sample stands for that many
     segments (:func:`_long_segment`, :mod:`vrlib.adaptive`).
