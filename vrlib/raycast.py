@@ -307,14 +307,17 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
                           dtype=np.int32)  # a tile's rows, then its columns
     costs = np.add.reduce(costs.reshape(rows, cols, TILE[1]), axis=2).ravel()
     live = np.flatnonzero(costs)
-    # One array type per argument (read-only samples, contiguous vectors): every other
-    # combination would compile the kernel once more.
+    # One array type per argument (read-only samples and grids, contiguous vectors): every
+    # other combination would compile the kernel once more.
     vector = np.ascontiguousarray
     layout = (readonly(data), vector(offset, np.int64), vector(global_shape, np.int64),
               vector(origin, np.float64), vector(spacing, np.float64),
               vector(box[0], np.float64), vector(box[1], np.float64),
               *lattice_extent(global_shape, spacing, origin).T.copy())
-    skips = (early_termination, *skip, np.zeros((1, 1, 1)) if bound is None else bound,
+    empty, clearance, block, mask = skip
+    skips = (early_termination, readonly(vector(empty, bool)),
+             readonly(vector(clearance, np.int64)), block, readonly(vector(mask, bool)),
+             readonly(vector(np.zeros((1, 1, 1)) if bound is None else bound, np.float64)),
              float(budget))
     # The tiles, heaviest first, behind a queue that every thread takes the next one from;
     # each thread's own scratch for the filter's weights (rows of MAX_TAPS = 8 floats, a

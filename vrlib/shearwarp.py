@@ -242,7 +242,8 @@ def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
             {2: (0, 1, 2, 3), 1: (0, 2, 1, 3), 0: (0, 3, 1, 2)}[axis])
     _kernel.shear_slices(slices, order, scale, di, dj, fraction, *filt.code, filt.radius,
                          ntaps, *tables, grads, *kernel_lighting(transfer, view.forward),
-                         np.ascontiguousarray(directions, np.float64), early_termination,
+                         readonly(np.ascontiguousarray(directions, np.float64)),
+                         early_termination,
                          readonly(first), readonly(last), inter, counts)
     # The warp: where each pixel's ray meets the front slice, in intermediate coordinates.
     plane = volume.origin[axis] + kf * h[axis]
