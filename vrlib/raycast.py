@@ -346,7 +346,8 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
                      *skips,
                      readonly(vector(np.ones((1, 1, 1)) if multiplier is None else multiplier,
                                      np.int64)),
-                     *tiles, grey, filtering, lit, skipping)
+                     *tiles, grey, filtering, lit, skipping,
+                     True if filtering is None and lit is None else None)
         lanes = _kernel.lanes(threads)
         on_threads(lambda i: _kernel.raycast(*arguments, scratch[i], *(a[i] for a in lanes)),
                    threads)

@@ -594,8 +594,8 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
             tstart, tinv, alpha_tab, color_tab, emit_tab,
             shade, ka, kd, ks, shininess, light, headlight, ramp_x, ramp_y, by_gradient,
             threshold, empty, clearance, block, mask, bound, budget, multiplier, tile_h, tile_w,
-            order, counter, out, samples, grey, filtering, lighting, skipping, scratch, rays,
-            steps, ray_state, ray_steps, status):
+            order, counter, out, samples, grey, filtering, lighting, skipping, packets, scratch,
+            rays, steps, ray_state, ray_steps, status):
     """Render ``out[row, col] = (r, g, b, a)`` premultiplied (``out`` comes transparent: a
     pixel whose ray meets nothing, and a tile left out of ``order``, stay so); count samples
     per tile.
@@ -632,7 +632,10 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
     ``lighting`` None only a table's colour (no shading, no gradient opacity), and
     ``skipping`` None leaves out the skipping (``block = 0``). numba drops a branch on a
     None argument before it types the function, so such a kernel compiles in a fraction of
-    the time (a first render's wait); ``True`` compiles that path. ``scratch``
+    the time (a first render's wait); ``True`` compiles that path. ``packets`` True (for
+    the tent filter without shading: ``filtering`` and ``lighting`` None) compiles the
+    packets below, None leaves them out (a branch on ``True`` is typed and compiled whether
+    taken or not: only a None argument drops one). ``scratch``
     (6 x ``MAX_TAPS``, this call's own) holds the filter's weights and their derivatives
     along x, y and z; ``rays, steps, ray_state, ray_steps, status`` are this call's lanes
     (:func:`lanes`).
@@ -766,8 +769,7 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                                 uy = ay + t * by
                                 uz = az + t * bz
                                 fraction = float(m)
-                        if (lighting is None and (filtering is None or fkind == TENT)
-                                and m_block == 1 and k != k_first and k != k_last
+                        if (packets is not None and m_block == 1 and k != k_first and k != k_last
                                 and _inside(k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in,
                                             t_out)):
                             # A run of samples inside the volume, up to the next skip check
@@ -847,6 +849,8 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                     status[lane] = DONE
                     _put_pixel(out, row0 + (p0 + lane) // tile_w, col0 + (p0 + lane) % tile_w,
                                acc_r, acc_g, acc_b, acc_a)
+                if packets is None:
+                    break  # a kernel without packets: every lane has marched to its end
                 waiting = False
                 for lane in range(LANES):
                     waiting = waiting or status[lane] == RUN
