@@ -292,6 +292,7 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
     elif skip[2] <= 0 or skip[2] & (skip[2] - 1):
         raise ValueError(f"skip's block must be a power of two (cells per block), got "
                          f"{skip[2]}")
+    empty, clearance, block, mask = skip
     ramp = transfer.gradient_opacity
     by_gradient = (np.zeros(2), np.zeros(2), False) if ramp is None else (
         ramp.magnitudes, ramp.factors, True)
@@ -302,7 +303,7 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
     # heaviest tiles first. Tiles without such a pixel stay transparent and are not handed
     # out at all.
     padded = np.zeros((rows * TILE[0], cols * TILE[1]), np.uint8)
-    padded[: view.height, : view.width] = skip[3]
+    padded[: view.height, : view.width] = mask
     costs = np.add.reduce(padded.reshape(rows, TILE[0], cols * TILE[1]), axis=1,
                           dtype=np.int32)  # a tile's rows, then its columns
     costs = np.add.reduce(costs.reshape(rows, cols, TILE[1]), axis=2).ravel()
@@ -314,7 +315,6 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
               vector(origin, np.float64), vector(spacing, np.float64),
               vector(box[0], np.float64), vector(box[1], np.float64),
               *lattice_extent(global_shape, spacing, origin).T.copy())
-    empty, clearance, block, mask = skip
     skips = (early_termination, readonly(vector(empty, bool)),
              readonly(vector(clearance, np.int64)), block, readonly(vector(mask, bool)),
              readonly(vector(np.zeros((1, 1, 1)) if bound is None else bound, np.float64)),
@@ -340,7 +340,7 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
         # wait).
         filtering = None if filt.code[0] == TENT else True
         lit = None if shading is None and ramp is None else True
-        skipping = None if skip[2] == 0 else True
+        skipping = None if block == 0 else True
         arguments = (*layout, bool(exact_ends), view.packed(), view.height, view.width, ds,
                      *filt.code, filt.radius, filt.taps, *tables, *lighting, *by_gradient,
                      *skips,
