@@ -95,9 +95,11 @@ report-check: $(REPORT)
 	$(PY) docs/report_check.py build/report/html
 
 # Two workers (pytest-xdist): the suite's time goes mostly into compiling kernels, which two
-# processes do side by side; test ids are the same in every process, as xdist needs.
+# processes do side by side; test ids are the same in every process, as xdist needs. Whole
+# files to a worker (--dist loadfile): a file's tests need the same kernels, and handed out
+# test by test both workers compiled them at once (fresh clone, this machine: 297 -> 226 s).
 test: $(INSTALLED)
-	$(PY) -m pytest -m "not slow" -n 2
+	$(PY) -m pytest -m "not slow" -n 2 --dist loadfile
 
 # Everything, slow checks included, then the kernels' comparisons with their naive twins again
 # with the JIT off, so that the numba kernels also run (and agree) as plain Python.

@@ -72,8 +72,19 @@ def _read_until(fd, deadline):
         os.close(fd)
 
 
+#: The readers' libraries, which vrlib imports when a file of their format is first read:
+#: imported once here, before the children fork (each child importing its own took a
+#: NIfTI or VTK case 0.2-0.3 s where the refusal itself takes 0.01).
+READERS = ("nibabel", "pyvista", "tifffile", "pydicom", "data_gen.nrrd_files")
+
+
 def main(cases_path, results_path):
+    import importlib
+
     import vrlib.cli  # noqa: F401 - imported once, before the children fork
+
+    for name in READERS:
+        importlib.import_module(name)
 
     with open(cases_path) as fh:
         cases = json.load(fh)

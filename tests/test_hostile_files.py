@@ -90,7 +90,9 @@ def build_cases(root):
     cases["nhdr-several-files"] = (info(_nhdr(folder, "g.nhdr", "LIST")), "several files")
 
     # Memory: sizes claimed beyond memory, bombs, huge sparse files.
-    bomb = gzip.compress(bytes(256 * 1024**2), compresslevel=9)  # 256 MB of zeros, ~250 KB
+    # 256 MB of zeros in ~260 KB: 64 gzip members of 4 MB each (RFC 1952 lets members
+    # follow one another; compressing 256 MB at once took the suite 1.9 s).
+    bomb = gzip.compress(bytes(4 * 1024**2), compresslevel=9) * 64
     cases["nrrd-gzip-bomb"] = (info(_nrrd(folder, "bomb.nrrd", bomb, sizes="16 16 16",
                                           encoding="gzip")), "inflate to more than")
     cases["nrrd-claims-huge"] = (info(_nrrd(folder, "huge.nrrd", bytes(64),

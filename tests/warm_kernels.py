@@ -17,11 +17,12 @@ def main():
     field = data_gen.make_field("gaussian-blob", sigma=0.3)
     view = vrlib.View.orbit(azimuth=30, elevation=20, size=8)
     lit = vrlib.Glow(1.0, shading=vrlib.Phong())
-    # The first tests need the ray caster and the splatter: the session compiles the first,
-    # this process the second, then what later tests need.
-    calls = [("splat", "trilinear", None), ("splat-perspective", "trilinear", None)]
-    calls += [(m, f, t) for m in ("shear3", "shear2", "shearwarp") for f, t in
-              [("catmull-rom", None), ("catmull-rom", lit), ("omoms", None)]]
+    # In the order the workers come to need them (`make test` hands out whole files, the
+    # largest first: the shear and ray-casting tests, which compile their own first kernels,
+    # then shear-warp's naive twins, the shear methods' threads, splatting, classified).
+    calls = [(m, f, t) for m in ("shearwarp", "shear3", "shear2") for f, t in
+             [("catmull-rom", None), ("catmull-rom", lit), ("omoms", None)]]
+    calls += [("splat", "trilinear", None), ("splat-perspective", "trilinear", None)]
     calls += [("classified", "trilinear", lit), ("classified", "trilinear", None)]
     calls += [(m, f, t) for m in ("splat", "raycast") for f, t in
               [("omoms", None), ("catmull-rom", lit)]]
