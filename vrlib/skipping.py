@@ -19,8 +19,8 @@ from typing import NamedTuple
 
 import numpy as np
 
+from vrlib._kernels import coverage as _coverage
 from vrlib.value_bounds import value_bounds
-from vrlib.view import BOX_CORNERS
 
 __all__ = ["BLOCK", "SkipGrid", "skip_grid", "block_densities", "empty_blocks",
            "brick_empty_blocks", "clearance", "visible_box", "footprint_mask",
@@ -211,8 +211,9 @@ def visible_box(volume, empty, block, lo, hi):
 def footprint_mask(view, lattice, empty, block):
     """Pixels whose rays can meet a non-empty block: the union of the blocks' projected
     bounding rectangles, one pixel wider all round (exact when conservative: a ray outside it
-    crosses only empty blocks, whose samples add nothing). ``lattice`` is anything with the
-    volume's sample ``shape``, ``origin`` and ``spacing`` (a :class:`vrlib.Volume`).
+    crosses only empty blocks, whose samples add nothing; :mod:`vrlib._kernels.coverage`).
+    ``lattice`` is anything with the volume's sample ``shape``, ``origin`` and ``spacing`` (a
+    :class:`vrlib.Volume`).
 
     Examples
     --------
@@ -226,24 +227,18 @@ def footprint_mask(view, lattice, empty, block):
     >>> bool(footprint_mask(view, volume, np.ones((4, 4, 4), dtype=bool), 8).any())
     False
     """
+    mask = np.zeros(view.shape, dtype=bool)
     full = np.argwhere(~empty)[:, ::-1]  # block indices, x y z
     if full.size == 0:
-        return np.zeros(view.shape, dtype=bool)
-    # Corner-major, (8, blocks, 3): numpy reduces over a leading axis of 8 far faster than
-    # over a trailing one.
-    cells = (BOX_CORNERS[:, None, :] + full[None, :, :]) * block
-    cells = np.minimum(cells, np.array(lattice.shape[::-1]) - 1)
-    projected = view.project(lattice.origin + cells * lattice.spacing)
-    if not np.all(np.isfinite(projected)) or np.any(projected[..., 2] <= 0.0):
-        return np.ones(view.shape, dtype=bool)  # a block reaches behind the eye: keep all
-    size = np.array(view.shape)
-    first = np.clip(np.floor(projected[..., :2].min(axis=0)).astype(np.intp) - 1, 0, size)
-    stop = np.clip(np.floor(projected[..., :2].max(axis=0)).astype(np.intp) + 2, 0, size)
-    mask = np.zeros(view.shape, dtype=bool)
-    lo, hi = first.min(axis=0), stop.max(axis=0)  # the rectangles' bounding box
-    height, width = hi - lo
-    if height <= 0 or width <= 0:
         return mask
+    vector = np.ascontiguousarray
+    if not _coverage.cover(view.packed(), vector(full, np.int64), int(block),
+                           np.array(lattice.shape[::-1], np.int64) - 1,
+                           vector(lattice.origin, np.float64),
+                           vector(lattice.spacing, np.float64),
+                           np.zeros(view.shape, np.int32), mask):
+        mask[:] = True  # a block reaches behind the eye: keep all
+    return mask
     # Each rectangle (row, col) as +1 at its first corner and its stop corner, -1 at the
     # other two, in the bounding box; summed along rows, then down columns, the marks count
     # the rectangles over each pixel (in 32 bits: numpy's wider sums take several times as
