@@ -197,11 +197,14 @@ def clearance(empty, *, through=True):
 def visible_box(volume, empty, block, lo, hi):
     """World box around every non-empty block (a sliver larger, so that samples on its faces
     are taken whatever the rounding), clipped to ``[lo, hi]``; empty if nothing is visible."""
-    full = np.argwhere(~empty)
-    if full.size == 0:
+    full = ~empty
+    if not full.any():
         return lo, lo.copy()  # t_out <= t_in for every ray
-    first = full.min(axis=0)[::-1] * block  # cells, x y z
-    last = (full.max(axis=0)[::-1] + 1) * block
+    # The first and last non-empty block along z, y and x (per axis: a third of the time
+    # of listing every such block).
+    spans = [np.flatnonzero(full.any(axis=others)) for others in ((1, 2), (0, 2), (0, 1))]
+    first = np.array([span[0] for span in spans])[::-1] * block  # cells, x y z
+    last = (np.array([span[-1] for span in spans])[::-1] + 1) * block
     sliver = 1e-9 * (hi - lo)
     box_lo = np.maximum(volume.origin + first * volume.spacing - sliver, lo)
     box_hi = np.minimum(volume.origin + last * volume.spacing + sliver, hi)
