@@ -172,9 +172,12 @@ def test_ranks_read_their_bricks_from_a_file(tmp_path):
     assert all(rss > 0 for r in results for rss in r["peak_rss"])
 
 
-# Rounds of each compositor on 4 ranks (binary swap: no fold, rounds 1 and 2).
-FAILURES = [("direct-send", 2, 0, "before"), ("binary-swap", 3, 2, "after"),
-            ("radix-k:2x2", 2, 1, "before"),
+# Rounds of each compositor on 4 ranks (binary swap: no fold, rounds 1 and 2). `make test`
+# runs one (each takes 4-7 s of mpiexec on 2 cores; a rank killed inside a radix-k round is
+# checked there too), `make test-all` every one.
+FAILURES = [("direct-send", 2, 0, "before"),
+            pytest.param("binary-swap", 3, 2, "after", marks=pytest.mark.slow),
+            pytest.param("radix-k:2x2", 2, 1, "before", marks=pytest.mark.slow),
             pytest.param("radix-k:2x2", 1, 0, "after", marks=pytest.mark.slow),
             pytest.param("binary-swap", 1, 1, "before", marks=pytest.mark.slow),
             pytest.param("binary-swap", 2, 2, "before", marks=pytest.mark.slow),
