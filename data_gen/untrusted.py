@@ -150,6 +150,8 @@ def inflate(fh, codec, nbytes, name):
     >>> import gzip, io
     >>> inflate(io.BytesIO(gzip.compress(b"abcd")), "gzip", 4, "v.nrrd")
     b'abcd'
+    >>> inflate(io.BytesIO(gzip.compress(b"ab") + gzip.compress(b"cd")), "gzip", 4, "v.nrrd")
+    b'abcd'
     >>> inflate(io.BytesIO(gzip.compress(bytes(10**6))), "gzip", 10, "v.nrrd")
     Traceback (most recent call last):
     ...
@@ -174,7 +176,12 @@ def inflate(fh, codec, nbytes, name):
                 out += engine.decompress(pending, room)
                 pending = engine.unconsumed_tail
                 if engine.eof:
-                    break
+                    # A gzip file may hold several members, one after another (RFC 1952,
+                    # what `cat a.gz b.gz` makes): go on with the next, if any follows.
+                    pending = engine.unused_data or fh.read(_CHUNK)
+                    if not pending:
+                        break
+                    engine = zlib.decompressobj(zlib.MAX_WBITS | 16)
             else:
                 out += engine.decompress(pending, max_length=room)
                 pending = b""

@@ -96,6 +96,22 @@ def test_nrrd_spacing_and_origin(tmp_path):
     np.testing.assert_allclose(data_gen.load(detached).spacing, [1, 2, 3])
 
 
+def test_gzip_nrrd_of_several_members_reads_whole(tmp_path):
+    """A gzip-encoded NRRD whose data are two gzip members one after the other (valid gzip,
+    what concatenating two .gz files makes) reads all of its samples; trailing bytes that
+    are not a gzip member are refused as corrupt, not ignored."""
+    raw = DATA.astype("<i2").tobytes()
+    header = (f"NRRD0004\ntype: short\ndimension: 3\nsizes: {DATA.shape[2]} {DATA.shape[1]} "
+              f"{DATA.shape[0]}\nendian: little\nencoding: gzip\n\n").encode()
+    half = len(raw) // 2
+    path = tmp_path / "two.nrrd"
+    path.write_bytes(header + gzip.compress(raw[:half]) + gzip.compress(raw[half:]))
+    np.testing.assert_array_equal(data_gen.load(path).data, DATA)
+    path.write_bytes(header + gzip.compress(raw) + b"not gzip")
+    with pytest.raises(ValueError, match="corrupt"):
+        data_gen.load(path)
+
+
 @pytest.mark.parametrize("compression", [None, "zlib"])
 def test_tiff_stack(tmp_path, compression):
     """An ImageJ stack with its resolution and z spacing; uncompressed stacks are
