@@ -97,7 +97,8 @@ report-check: $(REPORT)
 # Two workers (pytest-xdist): the suite's time goes mostly into compiling kernels, which two
 # processes do side by side; test ids are the same in every process, as xdist needs. Whole
 # files to a worker (--dist loadfile): a file's tests need the same kernels, and handed out
-# test by test both workers compiled them at once (fresh clone, this machine: 297 -> 226 s).
+# test by test both workers compiled them at once (empty kernel cache, this machine: 297 ->
+# 226 s).
 test: $(INSTALLED)
 	$(PY) -m pytest -m "not slow" -n 2 --dist loadfile
 

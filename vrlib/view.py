@@ -96,6 +96,7 @@ class View:
         #: Whether the scene sphere was given (False: :meth:`fitted` frames the volume).
         self.framed = center is not None or radius is not None
         self._given = {"up": up, "fov": fov, "distance": distance}
+        self._fitted = None  # (box, view): the last framing fitted() made (it reuses it)
         center = (0.0, 0.0, 0.0) if center is None else center
         radius = _DEFAULT_RADIUS if radius is None else radius
         f = validate.vector3("forward", forward, unit=True)
@@ -199,7 +200,7 @@ class View:
         box = extent_of(volume)
         # The last box's view is kept: renders of one view (another step, transfer function
         # or volume of the same box) ask again (0.1-0.3 ms of a render's Python each time).
-        kept = self.__dict__.get("_fitted")
+        kept = self._fitted
         if kept is not None and kept[0] == box.tobytes():
             return kept[1]
         view = View(self.forward, self._given["up"], size=self.shape, center=box.mean(axis=1),
