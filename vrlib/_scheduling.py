@@ -10,7 +10,29 @@ import threading
 
 import numba
 
-__all__ = ["on_threads", "thread_count"]
+__all__ = ["on_threads", "thread_count", "thread_number"]
+
+
+def thread_number(threads):
+    """``threads`` checked, or numba's setting for None: how many threads a render runs on.
+
+    For renderers whose kernels all run on :func:`on_threads` (no ``prange``), which need
+    the number alone: setting numba's and restoring it (:func:`thread_count`) costs some
+    10 microseconds a frame.
+
+    Raises
+    ------
+    TypeError, ValueError
+        ``threads`` not an integer, or outside 1 .. ``NUMBA_NUM_THREADS``.
+    """
+    if threads is None:
+        return numba.get_num_threads()
+    if isinstance(threads, bool) or not isinstance(threads, numbers.Integral):
+        raise TypeError(f"threads must be an integer, got {threads!r}")
+    limit = numba.config.NUMBA_NUM_THREADS
+    if not 1 <= threads <= limit:
+        raise ValueError(f"threads must be between 1 and {limit}, got {threads}")
+    return int(threads)
 
 
 @contextlib.contextmanager
@@ -25,11 +47,7 @@ def thread_count(threads):
     if threads is None:
         yield
         return
-    if isinstance(threads, bool) or not isinstance(threads, numbers.Integral):
-        raise TypeError(f"threads must be an integer, got {threads!r}")
-    limit = numba.config.NUMBA_NUM_THREADS
-    if not 1 <= threads <= limit:
-        raise ValueError(f"threads must be between 1 and {limit}, got {threads}")
+    threads = thread_number(threads)
     previous = numba.get_num_threads()
     if previous == threads:  # nothing to set or restore (each costs microseconds)
         yield

@@ -136,11 +136,11 @@ def warp_homography(view, volume, axis, plane, offsets):
     return np.array([[b - a, c - a, a] for a, b, c in zip(g00, g10, g01, strict=True)])
 
 
-def warp(inter, homography, out, grey=False):
+def warp(inter, homography, out, grey=False, *, threads=None):
     """The 2-D warp into ``out`` (``(height, width, 4)``): each pixel ``(c, r)`` samples
     ``inter`` (RGBA, or for a ``grey`` image red and opacity alone: ``(.., .., 2)``)
     bilinearly at ``(A / D, B / D)`` with ``(A, B, D) = homography @ (c, r, 1)``
-    (:func:`warp_homography`), on numba's thread count
+    (:func:`warp_homography`), on ``threads`` threads (None: numba's thread count)
     (:func:`vrlib._kernels.shear.warp_rows`, which says what it skips).
 
     Python threads run it (:func:`vrlib._scheduling.on_threads`), not a ``prange``: on one
@@ -167,7 +167,8 @@ def warp(inter, homography, out, grey=False):
     seen = _kernel.seen_box(inter) if affine else np.zeros(4)
     counter = np.zeros(1, np.int64)
     on_threads(lambda i: _kernel.warp_rows(inter, homography, out, grey, seen, WARP_BAND,
-                                           counter), numba.get_num_threads())
+                                           counter),
+               numba.get_num_threads() if threads is None else threads)
 
 
 def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,

@@ -97,6 +97,7 @@ class View:
         self.framed = center is not None or radius is not None
         self._given = {"up": up, "fov": fov, "distance": distance}
         self._fitted = None  # (box, view): the last framing fitted() made (it reuses it)
+        self._seen = None  # (box, answer): the last box sees() was asked about
         center = (0.0, 0.0, 0.0) if center is None else center
         radius = _DEFAULT_RADIUS if radius is None else radius
         f = validate.vector3("forward", forward, unit=True)
@@ -230,10 +231,19 @@ class View:
         Examples
         --------
         >>> view = View.orbit(size=8, radius=1.0)
-        >>> view.sees([[-1, 1], [-1, 1], [-1, 1]]), view.sees([[0, 1], [50, 60], [0, 1]])
-        (True, False)
+        >>> inside, outside = [[-1, 1], [-1, 1], [-1, 1]], [[0, 1], [50, 60], [0, 1]]
+        >>> view.sees(inside), view.sees(outside), view.sees(inside)
+        (True, False, True)
         """
         box = np.asarray(extent, dtype=np.float64)
+        # The last answer is kept: every frame of an animation asks again about one box.
+        key = (box.shape, box.tobytes())
+        if self._seen is None or self._seen[0] != key:
+            self._seen = (key, self._projects_into_image(box))
+        return self._seen[1]
+
+    def _projects_into_image(self, box):
+        """:meth:`sees`, computed."""
         corners = box[_AXES, BOX_CORNERS]  # (8, 3): x, y, z each at its low or high end
         if self.is_perspective:
             depth = self.to_camera(corners)[:, 2]
