@@ -40,6 +40,38 @@ def test_the_promise_is_kept(scene, tolerance):
     assert choices["method"] == "raycast" and choices["segment_ends"] == "exact"
 
 
+@pytest.mark.parametrize("coherent, uncorrelated", [(1.0, 0.0), (0.0, 1.0), (1.0, 1.0),
+                                                     (0.3, 1.0)])
+@pytest.mark.parametrize("order", [1.0, 1.5, 2.0])
+def test_the_finest_pilots_error_is_estimated_from_three_images(coherent, uncorrelated,
+                                                                order):
+    """Three images at steps h, h/2, h/4 whose errors hold a pattern that shrinks by 2^-p a
+    halving (Richardson's model) and noise of the same order that changes its pattern: the
+    estimate of the finest image's rms error, from the differences alone, is within 10% of
+    it. Without noise it is Richardson's ``d / (2^p - 1)``; with noise alone Richardson's
+    overestimates it, 2.2 times at order 1 and 1.4 at order 2 (so for aliased images it
+    chose steps half as long as they needed at order 1)."""
+    from vrlib.tolerance import finest_error
+
+    rng = np.random.default_rng(7)
+    truth, pattern = rng.random(200_000), rng.standard_normal(200_000)
+    r = 2.0**-order
+    images = [truth + 0.05 * r**k * (coherent * pattern + uncorrelated
+                                      * rng.standard_normal(truth.size)) for k in range(3)]
+    d0, d1 = images[0] - images[1], images[1] - images[2]
+    rms = [float(np.sqrt(np.mean(d * d))) for d in (d0, d1)]
+    estimate, kept = finest_error(*rms, float(np.mean(d0 * d1)), order)
+    error = metrics.rmse(images[2], truth)
+    assert abs(estimate - error) <= 0.1 * error
+    richardson = rms[1] / (2.0**order - 1.0)
+    assert richardson >= 0.95 * error
+    assert abs(kept - 0.05 * coherent * r**2) <= 0.1 * error  # the part keeping its pattern
+    if not uncorrelated:
+        assert abs(estimate - richardson) <= 0.02 * richardson
+    if not coherent:
+        assert richardson > 1.3 * estimate
+
+
 def test_a_smaller_tolerance_takes_a_smaller_step():
     vol = data_gen.make_field("marschner-lobb").sample(25)
     view = View.orbit(azimuth=30, elevation=20, size=40)

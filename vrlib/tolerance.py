@@ -17,10 +17,14 @@ How it is kept (docs/kernel.md):
 * The step takes :data:`STEP_SHARE` of ``t``. A pilot renders the view at a quarter of its
   pixels per axis with steps of 2, 1, 1/2 ... voxels. The differences between successive
   pilot images give the order of convergence ``p`` (taken between 1 and 2) and the error of
-  the finest, ``d / (2^p - 1)`` (Richardson). When the first two already differ by at most
-  half the share, the coarsest step is taken at once: its error is at most ``2 d`` for any
-  order of at least 1. The step is then the one whose extrapolated
-  error is the share, but never coarser than the pilot's coarsest. The pilot goes on halving
+  the finest, Richardson's ``d / (2^p - 1)``. That takes successive differences as pointing
+  the same way (a truncation error that keeps its pattern); where they do not (aliasing,
+  whose pattern changes with the step), the error is smaller (:func:`finest_error`), and the
+  longer step that allows is taken when one more pilot at it, compared with the finest,
+  confirms it. When the first two already differ
+  by at most half the share, the coarsest step is taken at once: its error is at most
+  ``2 d`` for any order of at least 1. The step is then the one whose extrapolated error is
+  the share, but never coarser than the pilot's coarsest. The pilot goes on halving
   while the step it predicts lies below half its finest step, so the prediction never
   reaches far past what it measured.
 * A tolerance that would need a step below :data:`MIN_STEP` voxel is refused, with the
@@ -34,12 +38,13 @@ from __future__ import annotations
 import math
 import time
 
+import numpy as np
+
 from vrlib import validate
-from vrlib.metrics import rmse
 from vrlib.raycast import brightest, render_raycast
 from vrlib.value_bounds import reconstructed_range
 
-__all__ = ["render_within", "TERM_SHARE", "STEP_SHARE", "MIN_STEP", "MAX_STEP"]
+__all__ = ["render_within", "finest_error", "TERM_SHARE", "STEP_SHARE", "MIN_STEP", "MAX_STEP"]
 
 #: How a render to a tolerance classifies its segments. Measured on the chapter's matrix
 #: (96^2): point sampling with exact ends kept every promise pre-integration kept, in 1.0 to
@@ -101,14 +106,17 @@ def render_within(volume, view, *, filt, transfer, tolerance, empty_space_skippi
     if pilot_view.height >= view.height and pilot_view.width >= view.width:
         pilot_view = view
     target = STEP_SHARE * tolerance
-    steps, differences = [], []
+    steps, differences, alignments = [], [], []
     step = MAX_STEP
-    previous = predicted = None
+    previous = change = predicted = None
     while True:
         steps.append(step)
-        pilot = render_raycast(volume, pilot_view, step=step, **options)
+        pilot = render_raycast(volume, pilot_view, step=step, **options).rgba
         if previous is not None:
-            differences.append(rmse(previous, pilot))
+            last_change, change = change, previous - pilot
+            differences.append(float(np.sqrt(np.mean(change * change))))
+            if last_change is not None:
+                alignments.append(float(np.mean(last_change * change)))
         previous = pilot
         if len(differences) == 1 and 2.0 * differences[0] <= target:
             # The coarsest step already meets the share: with order >= 1 its error is at
@@ -116,10 +124,26 @@ def render_within(volume, view, *, filt, transfer, tolerance, empty_space_skippi
             predicted, error_at = MAX_STEP, _first_order_bound(differences[0])
             break
         if len(differences) >= 2:
-            predicted, error_at = _predict(steps, differences, target)
+            predicted, error_at, _ = _predict(steps, differences, target)
             if predicted >= 0.5 * steps[-1] or step / 2.0 < MIN_STEP:
                 break
         step /= 2.0
+    checked = None
+    if alignments:
+        # Richardson's error takes the differences as aligned; where they are not, the
+        # finest pilot's error is smaller and a longer step may do. One more pilot at that
+        # step measures its error against the finest, m: with e = k s + n (k the part that
+        # keeps its pattern, n the rest, uncorrelated) at both steps, e^2 <= m^2 + 2 k k_f
+        # - k_f^2. The longer step is taken only when that is within the share.
+        longer, longer_error_at, kept_at = _predict(steps, differences, target,
+                                                    alignments[-1])
+        if longer > predicted:
+            checked = float(min(longer, MAX_STEP))
+            change = render_raycast(volume, pilot_view, step=checked, **options).rgba - previous
+            kept, kept_finest = kept_at(checked), kept_at(steps[-1])
+            if np.mean(change * change) + 2.0 * kept * kept_finest - kept_finest**2 \
+                    <= target**2:
+                predicted, error_at = longer, longer_error_at
     if predicted < MIN_STEP:
         reach = error_at(MIN_STEP)
         raise ValueError(
@@ -137,7 +161,8 @@ def render_within(volume, view, *, filt, transfer, tolerance, empty_space_skippi
         "classification": classification, "segment_ends": "exact",
         "early_termination": early_termination, "skip_budget": 0.0, "estimate": estimate,
         "pilot": {"shape": list(pilot_view.shape), "steps": steps,
-                  "differences": differences, "seconds": pilot_seconds},
+                  "differences": differences, "alignments": alignments,
+                  "checked": checked, "seconds": pilot_seconds},
     }
     return image
 
@@ -148,23 +173,72 @@ def _first_order_bound(difference):
     return lambda h: 2.0 * difference * h / MAX_STEP
 
 
-def _predict(steps, differences, target):
-    """The step whose extrapolated error is ``target``, and the error model it uses.
+def _predict(steps, differences, target, alignment=None):
+    """The step whose extrapolated error is ``target``, the error model it uses, and the
+    part of that error that keeps its pattern (all of it for Richardson's), at step ``h``.
 
     ``differences[i]`` is the rmse between the pilot images at ``steps[i]`` and
     ``steps[i + 1] = steps[i] / 2``. The order ``p`` comes from the last two differences
-    (between 1 and 2); the error of the finest pilot is ``d / (2^p - 1)``, and the error at
-    step ``h`` is taken as that times ``(h / finest)^p``.
+    (between 1 and 2); the error at step ``h`` is taken as the finest pilot's times
+    ``(h / finest)^p``. The finest pilot's error is Richardson's ``d / (2^p - 1)``, or with
+    ``alignment``, the mean product of the last two differences pixel by pixel,
+    :func:`finest_error`'s.
     """
     d_prev, d_last = differences[-2], differences[-1]
     finest = steps[-1]
     if not d_last > 0.0:
-        return MAX_STEP, lambda h: 0.0
+        return MAX_STEP, lambda h: 0.0, lambda h: 0.0
     order = math.log2(d_prev / d_last) if d_prev > 0.0 else 2.0
     order = min(max(order, 1.0), 2.0)
-    error = d_last / (2.0**order - 1.0)
+    if alignment is None:
+        error = kept = d_last / (2.0**order - 1.0)
+    else:
+        error, kept = finest_error(d_prev, d_last, alignment, order)
 
     def error_at(h):
         return error * (h / finest) ** order
 
-    return finest * (target / error) ** (1.0 / order), error_at
+    def kept_at(h):
+        return kept * (h / finest) ** order
+
+    return finest * (target / error) ** (1.0 / order), error_at, kept_at
+
+
+def finest_error(d_prev, d_last, alignment, order):
+    """The error of the finest of three pilot images ``I0, I1, I2`` (steps ``h, h/2, h/4``)
+    from their differences ``D0 = I0 - I1`` and ``D1 = I1 - I2``: their rms ``d_prev`` and
+    ``d_last`` and their mean product ``alignment``.
+
+    Each image's error is taken as a part that keeps its pattern from step to step and
+    shrinks by ``r = 2^-order`` a halving (``a r^k s``: the truncation error of a resolved
+    field, which Richardson's ``d / (2^p - 1)`` assumes alone), plus a part that changes its
+    pattern (``sigma r^k`` rms, uncorrelated between steps: aliasing of a steep transfer
+    function, shading's highlights). The first makes the differences point the same way,
+    the second opposite ways, so ``alignment`` tells the two apart. With ``A = a (1 - r)``,
+    ``d_last^2 = r^2 S`` where ``S = A^2 + sigma^2 (1 + r^2)``, and ``alignment = A^2 r -
+    sigma^2 r^2``, so that
+
+        sigma^2 = (S - alignment / r) / (1 + r + r^2),
+
+    and the finest error is ``sqrt((A r^2 / (1 - r))^2 + sigma^2 r^4)``: Richardson's when
+    the differences are aligned, ``d_last r / sqrt(1 + r^2)`` when they are not correlated.
+    It is never taken below the uncorrelated error at the measured ratio ``d_last /
+    d_prev`` (between 1/4 and 1): an error that stopped shrinking is not extrapolated away.
+
+    Returns ``(error, kept)``: the rms error and the rms of its part that keeps its pattern.
+
+    Examples
+    --------
+    >>> [round(e, 6) for e in finest_error(0.4, 0.1, 0.4 * 0.1, 2.0)]   # d / (2^p - 1)
+    [0.033333, 0.033333]
+    >>> [round(e, 6) for e in finest_error(0.4, 0.1, -0.1**2 / (1 + 0.25**2), 2.0)]
+    [0.024254, 0.0]
+    """
+    r = 2.0 ** -order
+    total = (d_last / r) ** 2  # A^2 + sigma^2 (1 + r^2)
+    sigma2 = (total - alignment / r) / (1.0 + r + r * r)
+    sigma2 = min(max(sigma2, 0.0), total / (1.0 + r * r))  # both parts at least 0
+    coherent = math.sqrt(max(total - sigma2 * (1.0 + r * r), 0.0)) * r * r / (1.0 - r)
+    error = math.sqrt(coherent**2 + sigma2 * r**4)
+    measured = min(max(d_last / d_prev, 0.25), 1.0) if d_prev > 0.0 else 0.25
+    return max(error, d_last * measured / math.sqrt(1.0 + measured**2)), coherent
