@@ -242,21 +242,6 @@ def footprint_mask(view, lattice, empty, block):
                            np.zeros(view.shape, np.int32), mask):
         mask[:] = True  # a block reaches behind the eye: keep all
     return mask
-    # Each rectangle (row, col) as +1 at its first corner and its stop corner, -1 at the
-    # other two, in the bounding box; summed along rows, then down columns, the marks count
-    # the rectangles over each pixel (in 32 bits: numpy's wider sums take several times as
-    # long).
-    first, stop, span = first - lo, stop - lo, width + 1
-    bins = (height + 1) * span
-    plus = np.bincount(np.concatenate([first[:, 0] * span + first[:, 1],
-                                       stop[:, 0] * span + stop[:, 1]]), minlength=bins)
-    minus = np.bincount(np.concatenate([first[:, 0] * span + stop[:, 1],
-                                        stop[:, 0] * span + first[:, 1]]), minlength=bins)
-    marks = (plus - minus).astype(np.int32).reshape(height + 1, span)
-    np.cumsum(marks, axis=1, dtype=np.int32, out=marks)
-    np.cumsum(marks, axis=0, dtype=np.int32, out=marks)
-    mask[lo[0]:hi[0], lo[1]:hi[1]] = marks[:-1, :-1] > 0
-    return mask
 
 
 _RUNS_KEPT = 8  # run tables cached per volume (one per slicing axis and transfer function)
