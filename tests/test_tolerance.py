@@ -72,6 +72,36 @@ def test_the_finest_pilots_error_is_estimated_from_three_images(coherent, uncorr
         assert richardson > 1.3 * estimate
 
 
+@pytest.mark.parametrize("case", ["confirmed", "refused"])
+def test_a_longer_step_is_taken_only_when_a_pilot_confirms_it(case):
+    """Where the pilots' differences do not point the same way, the longer step the split
+    error allows is rendered as one more pilot and taken only if that pilot bears it out.
+    Marschner-Lobb in perspective at 1e-3: confirmed, and the promise kept. Six sparse blobs
+    at 1e-4: the longer step (1.16 voxels, off the lattice the pilots' steps sit on) misses
+    the tolerance by 1.7 times, so it is refused and Richardson's step (0.99) taken."""
+    if case == "confirmed":
+        vol = data_gen.make_field("marschner-lobb").sample(41)
+        transfer, tolerance = Glow(1.0), 1e-3
+        view = View.orbit(azimuth=-60, elevation=35, projection="perspective", size=48)
+    else:
+        vol = data_gen.make_field("random-blobs", count=6, seed=4, sigma=(0.06, 0.1)).sample(64)
+        transfer, tolerance = Glow(8.0), 1e-4
+        view = View.orbit(azimuth=30, elevation=20, size=64)
+    exact = render_reference(vrlib.ReconstructedField(vol), view, transfer=transfer, tol=1e-8)
+    img = render(vol, view, transfer=transfer, tolerance=tolerance)
+    choices = img.stats.choices
+    checked = choices["pilot"]["checked"]
+    assert checked is not None
+    assert metrics.rmse(img, exact) <= tolerance
+    if case == "confirmed":
+        assert choices["step"] == checked
+    else:
+        assert choices["step"] < checked
+        longer = render(vol, view, transfer=transfer, step=checked, segment_ends="exact",
+                        early_termination=choices["early_termination"])
+        assert metrics.rmse(longer, exact) > tolerance
+
+
 def test_a_smaller_tolerance_takes_a_smaller_step():
     vol = data_gen.make_field("marschner-lobb").sample(25)
     view = View.orbit(azimuth=30, elevation=20, size=40)

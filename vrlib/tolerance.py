@@ -21,12 +21,11 @@ How it is kept (docs/kernel.md):
   the same way (a truncation error that keeps its pattern); where they do not (aliasing,
   whose pattern changes with the step), the error is smaller (:func:`finest_error`), and the
   longer step that allows is taken when one more pilot at it, compared with the finest,
-  confirms it. When the first two already differ
-  by at most half the share, the coarsest step is taken at once: its error is at most
-  ``2 d`` for any order of at least 1. The step is then the one whose extrapolated error is
-  the share, but never coarser than the pilot's coarsest. The pilot goes on halving
-  while the step it predicts lies below half its finest step, so the prediction never
-  reaches far past what it measured.
+  confirms it. When the first two already differ by at most half the share, the coarsest
+  step is taken at once: its error is at most ``2 d`` for any order of at least 1. The step
+  is then the one whose extrapolated error is the share, but never coarser than the pilot's
+  coarsest. The pilot goes on halving while the step it predicts lies below half its finest
+  step, so the prediction never reaches far past what it measured.
 * A tolerance that would need a step below :data:`MIN_STEP` voxel is refused, with the
   error that step reaches, never answered with a worse image.
 
@@ -137,12 +136,12 @@ def render_within(volume, view, *, filt, transfer, tolerance, empty_space_skippi
         # - k_f^2. The longer step is taken only when that is within the share.
         longer, longer_error_at, kept_at = _predict(steps, differences, target,
                                                     alignments[-1])
-        if longer > predicted:
+        if min(longer, MAX_STEP) > min(predicted, MAX_STEP):
             checked = float(min(longer, MAX_STEP))
-            change = render_raycast(volume, pilot_view, step=checked, **options).rgba - previous
+            miss = render_raycast(volume, pilot_view, step=checked, **options).rgba - previous
             kept, kept_finest = kept_at(checked), kept_at(steps[-1])
-            if np.mean(change * change) + 2.0 * kept * kept_finest - kept_finest**2 \
-                    <= target**2:
+            bound = np.mean(miss * miss) + 2.0 * kept * kept_finest - kept_finest**2
+            if bound <= target**2:
                 predicted, error_at = longer, longer_error_at
     if predicted < MIN_STEP:
         reach = error_at(MIN_STEP)
