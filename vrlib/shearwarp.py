@@ -94,13 +94,20 @@ def intermediate_plane(volume, view, axis, ascending):
         def rays(points):
             return np.concatenate([points, np.full(points.shape[:-1] + (1,), float(kf))],
                                   -1) - eye
-    # Where the end slices land on the plane: the intermediate image covers both.
-    front, back, top = shift[:, 0], shift[:, -1], n[:2] - 1.0
-    low = np.minimum((0.0 - front) / scale[0], (0.0 - back) / scale[-1])
-    high = np.maximum((top - front) / scale[0], (top - back) / scale[-1])
-    width, height = (np.ceil(high - low - 1e-9).astype(int) + 1)
-    di, dj = shift + scale * low[:, None]  # sample = scale * I + d
-    return scale, di, dj, -low, (int(height), int(width)), kf, rays
+    # Where the end slices land on the plane: the intermediate image covers both (per
+    # axis, in plain floats: numpy's calls cost more than their arithmetic here).
+    s0, s1 = float(scale[0]), float(scale[-1])
+    low, size = [], []
+    for front, back, top in zip(shift[:, 0].tolist(), shift[:, -1].tolist(),
+                                (n[:2] - 1.0).tolist(), strict=True):
+        a, b = (0.0 - front) / s0, (0.0 - back) / s1
+        lo = a if a < b else b  # as numpy's minimum and maximum pick (signed zeros too)
+        a, b = (top - front) / s0, (top - back) / s1
+        hi = a if a > b else b
+        low.append(lo)
+        size.append(math.ceil(hi - lo - 1e-9) + 1)
+    di, dj = shift + scale * np.array(low)[:, None]  # sample = scale * I + d
+    return scale, di, dj, -np.array(low), (size[1], size[0]), kf, rays
 
 
 def warp_homography(view, volume, axis, plane, offsets):
