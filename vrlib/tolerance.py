@@ -133,13 +133,16 @@ def render_within(volume, view, *, filt, transfer, tolerance, empty_space_skippi
         # finest pilot's error is smaller and a longer step may do. One more pilot at that
         # step measures its error against the finest, m: with e = k s + n (k the part that
         # keeps its pattern, n the rest, uncorrelated) at both steps, e^2 <= m^2 + 2 k k_f
-        # - k_f^2. The longer step is taken only when that is within the share.
-        longer, longer_error_at, kept_at = _predict(steps, differences, target,
-                                                    alignments[-1])
-        if min(longer, MAX_STEP) > min(predicted, MAX_STEP):
+        # - k_f^2 = e^2 + |n_f|^2 by the model. So the longer step aims at e^2 = share^2 -
+        # |n_f|^2, and is taken only when the pilot bears that out.
+        _, finest_at, kept_at = _predict(steps, differences, target, alignments[-1])
+        finest, kept_finest = finest_at(steps[-1]), kept_at(steps[-1])
+        aim = math.sqrt(max(target**2 - (finest**2 - kept_finest**2), 0.0))
+        longer, longer_error_at, _ = _predict(steps, differences, aim, alignments[-1])
+        if aim > 0.0 and min(longer, MAX_STEP) > min(predicted, MAX_STEP):
             checked = float(min(longer, MAX_STEP))
             miss = render_raycast(volume, pilot_view, step=checked, **options).rgba - previous
-            kept, kept_finest = kept_at(checked), kept_at(steps[-1])
+            kept = kept_at(checked)
             bound = np.mean(miss * miss) + 2.0 * kept * kept_finest - kept_finest**2
             if bound <= target**2:
                 predicted, error_at = longer, longer_error_at
