@@ -77,8 +77,8 @@ def test_a_longer_step_is_taken_only_when_a_pilot_confirms_it(case):
     """Where the pilots' differences do not point the same way, the longer step the split
     error allows is rendered as one more pilot and taken only if that pilot bears it out.
     Marschner-Lobb in perspective at 1e-3: confirmed, and the promise kept. Six sparse blobs
-    at 1e-4: the longer step (1.16 voxels, off the lattice the pilots' steps sit on) misses
-    the tolerance by 1.7 times, so it is refused and Richardson's step (0.99) taken."""
+    at 1e-4: the longer step (1.15 voxels, off the lattice the pilots' steps sit on) misses
+    the tolerance by 1.8 times, so it is refused and Richardson's step (0.99) taken."""
     if case == "confirmed":
         vol = data_gen.make_field("marschner-lobb").sample(41)
         transfer, tolerance = Glow(1.0), 1e-3
