@@ -18,13 +18,12 @@ from __future__ import annotations
 import math
 import time
 
-import numba
 import numpy as np
 
 from vrlib import validate
 from vrlib._kernels import shear as _kernel
 from vrlib._kernels._jit import readonly
-from vrlib._scheduling import on_threads
+from vrlib._scheduling import on_threads, thread_number
 from vrlib.gradients import kernel_lighting, no_gradients
 from vrlib.image import Image, RenderStats
 from vrlib.prefilter import Tally, prepared, prepared_gradients
@@ -175,7 +174,7 @@ def warp(inter, homography, out, grey=False, *, threads=None):
     counter = np.zeros(1, np.int64)
     on_threads(lambda i: _kernel.warp_rows(inter, homography, out, grey, seen, WARP_BAND,
                                            counter),
-               numba.get_num_threads() if threads is None else threads)
+               thread_number(threads))
 
 
 def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
