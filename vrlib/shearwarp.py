@@ -68,17 +68,23 @@ def intermediate_plane(volume, view, axis, ascending):
     index units of the ray through plane points (index units, ``[..., (i, j)]``)."""
     q_axis, p_axis = [a for a in range(3) if a != axis]  # columns i, rows j (Volume.slices)
     axes = [q_axis, p_axis, axis]
-    n = np.array(volume.shape[::-1])[axes]  # (n_i, n_j, n_k)
-    kf = 0 if ascending else int(n[2]) - 1
-    k = np.arange(n[2], dtype=float)
+    n = [volume.shape[2 - a] for a in axes]  # (n_i, n_j, n_k)
+    kf = 0 if ascending else n[2] - 1
     if not view.is_perspective:
-        direction = (view.forward / volume.spacing)[axes]
-        slope = direction[:2] / direction[2]
+        # In plain floats (a frame of VolPack's example: numpy's calls on vectors this short
+        # cost more than their arithmetic), the same operations as on arrays.
+        forward, spacing = view.forward.tolist(), volume.spacing.tolist()
+        direction = [forward[a] / spacing[a] for a in axes]
+        slope = [direction[0] / direction[2], direction[1] / direction[2]]
+        # sample = plane point + slope (k - kf): where the end slices land.
+        low, size = _covering([(t * (0.0 - kf), t * (n[2] - 1.0 - kf)) for t in slope],
+                              1.0, 1.0, n)
         scale = np.ones(n[2])
-        shift = slope[:, None] * (k - kf)  # sample = plane point + shift
+        offsets = np.arange(n[2], dtype=float) - kf
+        di, dj = (t * offsets + start for t, start in zip(slope, low, strict=True))
 
         def rays(points):
-            return np.broadcast_to(direction, points.shape[:-1] + (3,))
+            return np.broadcast_to(np.array(direction), points.shape[:-1] + (3,))
     else:
         eye = ((view.eye - volume.origin) / volume.spacing)[axes]
         if (eye[2] >= 0.0) if ascending else (eye[2] <= n[2] - 1):
@@ -87,26 +93,33 @@ def intermediate_plane(volume, view, axis, ascending):
                 f"perspective shear-warp needs the eye outside the volume's slab along its "
                 f"principal axis {name}: the eye is at {name} index {eye[2]:.3g}, the slab spans "
                 f"[0, {n[2] - 1}]; move the eye out or use method='raycast'")
+        k = np.arange(n[2], dtype=float)
         scale = (k - eye[2]) / (kf - eye[2])  # >= 1: slices behind the front one shrink
         shift = eye[:2, None] * (1.0 - scale)  # sample = scale * plane point + shift
+        low, size = _covering(zip(shift[:, 0].tolist(), shift[:, -1].tolist(), strict=True),
+                              float(scale[0]), float(scale[-1]), n)
+        di, dj = shift + scale * np.array(low)[:, None]  # sample = scale * I + d
 
         def rays(points):
             return np.concatenate([points, np.full(points.shape[:-1] + (1,), float(kf))],
                                   -1) - eye
-    # Where the end slices land on the plane: the intermediate image covers both (per
-    # axis, in plain floats: numpy's calls cost more than their arithmetic here).
-    s0, s1 = float(scale[0]), float(scale[-1])
+    return scale, di, dj, -np.array(low), (size[1], size[0]), kf, rays
+
+
+def _covering(ends, s0, s1, n):
+    """The intermediate image's low corner and size per axis (i, j): it covers both end
+    slices, which land at ``(index - shift) / scale`` for their ``(shift, scale)``, ``ends``
+    holding the two shifts per axis (in plain floats: numpy's minimum and maximum picked as
+    numpy picks them, signed zeros too)."""
     low, size = [], []
-    for front, back, top in zip(shift[:, 0].tolist(), shift[:, -1].tolist(),
-                                (n[:2] - 1.0).tolist(), strict=True):
+    for (front, back), top in zip(ends, (n[0] - 1.0, n[1] - 1.0), strict=True):
         a, b = (0.0 - front) / s0, (0.0 - back) / s1
-        lo = a if a < b else b  # as numpy's minimum and maximum pick (signed zeros too)
+        lo = a if a < b else b
         a, b = (top - front) / s0, (top - back) / s1
         hi = a if a > b else b
         low.append(lo)
         size.append(math.ceil(hi - lo - 1e-9) + 1)
-    di, dj = shift + scale * np.array(low)[:, None]  # sample = scale * I + d
-    return scale, di, dj, -np.array(low), (size[1], size[0]), kf, rays
+    return low, size
 
 
 def warp_homography(view, volume, axis, plane, offsets):
@@ -121,21 +134,26 @@ def warp_homography(view, volume, axis, plane, offsets):
     pixel = view.plane_pixel
     h, origin = volume.spacing.tolist(), volume.origin.tolist()
     start = view.start.tolist()
-    eye = start  # perspective: rays start at the eye
     rows = []
     for col, row in [(0, 0), (1, 0), (0, 1)]:
         along, down = col + 0.5 - 0.5 * view.width, 0.5 * view.height - row - 0.5
-        offset = [(along * r + down * u) * pixel for r, u in zip(right, up, strict=True)]
-        if not view.is_perspective:
-            begin = [s + o for s, o in zip(start, offset, strict=True)]
-            reach = (plane - begin[axis]) / forward[axis]
-            d, scaled = 1.0, [b + reach * f for b, f in zip(begin, forward, strict=True)]
-        else:  # eye + (plane - eye_axis) / d_axis * d, scaled by d_axis (> 0 toward the plane)
-            direction = [f + o for f, o in zip(forward, offset, strict=True)]
-            sign = math.copysign(1.0, plane - eye[axis])
-            d = sign * direction[axis]
-            scaled = [sign * ((plane - eye[axis]) * t + direction[axis] * e)
-                      for t, e in zip(direction, eye, strict=True)]
+        if not view.is_perspective:  # from the pixel's start on the plane (D = 1)
+            bq, bp, ba = [start[a] + (along * right[a] + down * up[a]) * pixel
+                          for a in (q_axis, p_axis, axis)]
+            reach = (plane - ba) / forward[axis]
+            rows.append([(bq + reach * forward[q_axis] - origin[q_axis]) / h[q_axis]
+                         + offsets[0],
+                         (bp + reach * forward[p_axis] - origin[p_axis]) / h[p_axis]
+                         + offsets[1], 1.0])
+            continue
+        # eye + (plane - eye_axis) / d_axis * d, scaled by d_axis (> 0 toward the plane)
+        eye = start
+        direction = [f + (along * r + down * u) * pixel
+                     for f, r, u in zip(forward, right, up, strict=True)]
+        sign = math.copysign(1.0, plane - eye[axis])
+        d = sign * direction[axis]
+        scaled = [sign * ((plane - eye[axis]) * t + direction[axis] * e)
+                  for t, e in zip(direction, eye, strict=True)]
         rows.append([(scaled[q_axis] - d * origin[q_axis]) / h[q_axis] + d * offsets[0],
                      (scaled[p_axis] - d * origin[p_axis]) / h[p_axis] + d * offsets[1], d])
     g00, g10, g01 = rows
