@@ -16,6 +16,7 @@ tangent to that sphere nearest the viewer; perspective rays start at the eye.
 
 from __future__ import annotations
 
+import copy
 import math
 
 import numpy as np
@@ -111,8 +112,8 @@ class View:
         right /= np.linalg.norm(right)
         self._basis = np.array([right, np.cross(right, f), f])
         self._basis.flags.writeable = False
-        self.height, self.width = _image_size(size)
-        self.center = validate.vector3("center", center)
+        self.center = validate.vector3("center", center).copy()  # not the caller's array
+        self.center.flags.writeable = False  # shared with the resized views
         self.radius = validate.positive_number("radius", radius)
         self.projection = validate.choice("projection", projection, PROJECTIONS)
         self.zoom = validate.positive_number("zoom", zoom)
@@ -120,8 +121,6 @@ class View:
             if fov is not None or distance is not None:
                 raise ValueError("fov and distance apply to the perspective projection only")
             self.fov = self.distance = None
-            # Width of one pixel on the image plane, in world units.
-            self._pixel = 2.0 * self.radius / (self.zoom * min(self.height, self.width))
         else:
             if distance is None:
                 distance = 4.0 * self.radius
@@ -135,10 +134,7 @@ class View:
                 fov = 2.0 * math.degrees(math.asin(self.radius / self.distance))
             self.fov = validate.finite_number("fov", fov, low=0.0, high=180.0,
                                                low_open=True, high_open=True)
-            half = math.tan(math.radians(self.fov) / 2.0) / self.zoom
-            # Width of one pixel on the plane one world unit in front of the eye.
-            self._pixel = 2.0 * half / min(self.height, self.width)
-        self._pixel_size = self._pixel if self.distance is None else self._pixel * self.distance
+        self._set_size(size)
 
     @classmethod
     def orbit(cls, *, azimuth=0.0, elevation=0.0, size=256, projection="orthographic",
@@ -221,9 +217,22 @@ class View:
         >>> small.shape, round(small.pixel_size / view.pixel_size, 6)
         ((16, 16), 4.0)
         """
-        return View(self.forward, self._given["up"], size=size, center=self.center,
-                    radius=self.radius, projection=self.projection, zoom=self.zoom,
-                    fov=self.fov if self.is_perspective else None, distance=self.distance)
+        view = copy.copy(self)  # the same camera (its arrays are read-only), other pixels
+        view._fitted = view._seen = None
+        view._set_size(size)
+        return view
+
+    def _set_size(self, size):
+        """The image's ``size`` and the pixels' pitch that follows from it."""
+        self.height, self.width = _image_size(size)
+        if self.projection == "orthographic":
+            # Width of one pixel on the image plane, in world units.
+            self._pixel = 2.0 * self.radius / (self.zoom * min(self.height, self.width))
+        else:
+            half = math.tan(math.radians(self.fov) / 2.0) / self.zoom
+            # Width of one pixel on the plane one world unit in front of the eye.
+            self._pixel = 2.0 * half / min(self.height, self.width)
+        self._pixel_size = self._pixel if self.distance is None else self._pixel * self.distance
 
     def sees(self, extent):
         """Whether any part of the world box ``extent`` projects into the image.
