@@ -109,6 +109,16 @@ def test_a_smaller_tolerance_takes_a_smaller_step():
     assert steps[0] >= steps[1] > steps[2]
 
 
+@pytest.mark.parametrize("size, pilot", [(40, (32, 32)), ((200, 160), (50, 40)),
+                                         (512, (64, 64)), ((1024, 96), (64, 32))])
+def test_the_pilot_takes_a_quarter_of_the_pixels_per_axis_from_32_to_64(size, pilot):
+    """A pilot's rays sample the image's: a quarter of them per axis, at least 32 and at most
+    64 a side (more cost much on a large image: rays far apart miss the cache)."""
+    vol = data_gen.make_field("gaussian-blob").sample(12)
+    img = render(vol, View.orbit(size=size), tolerance=1e-2)
+    assert tuple(img.stats.choices["pilot"]["shape"]) == pilot
+
+
 def test_method_auto_is_ray_casting():
     vol = data_gen.make_field("gaussian-blob").sample(12)
     view = View.orbit(size=16)
