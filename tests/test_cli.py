@@ -88,6 +88,15 @@ def test_render_to_a_tolerance_matches_the_python_api(tmp_path):
     np.testing.assert_array_equal(np.load(out), expected.rgba)
 
 
+def test_method_auto_says_which_method_it_ran(tmp_path):
+    for extra in ([], ["--tolerance", "1e-2"]):
+        done = run("render", "gaussian-blob:8", "--method", "auto", "--size", "8", *extra,
+                   "-o", str(tmp_path / "blob.png"))
+        assert done.returncode == 0, done.stderr
+        said = done.stdout.split(": ", 1)[1]  # after the output's path
+        assert said.startswith("8x8 raycast/trilinear ") and "auto" not in said
+
+
 def test_render_classified_matches_the_python_api(tmp_path):
     """``--classified`` is :func:`vrlib.classify` and its render, shading included."""
     import data_gen

@@ -344,6 +344,7 @@ def _load(args):
 def cmd_render(args):
     import vrlib
     from vrlib.cost import measure
+    from vrlib.render import chosen_method
 
     check_output(args.output, (".png", ".npy"), source=args.volume)
     volume, field = _load(args)
@@ -386,7 +387,7 @@ def cmd_render(args):
         seconds, img = measure(partial(
             vrlib.render, volume, view, method=method, filter=_filter(args),
             transfer=transfer, step=step, blend=blend, **options), repeats=1, warmup=False)
-        what = f"{method}/{_filter(args)}"
+        what = f"{chosen_method(method)}/{_filter(args)}"
         if blend != "emission-absorption":
             what += f", {blend} intensity projection"
     img.save(args.output, bits=args.bits)

@@ -19,7 +19,7 @@ from vrlib.splat import render_splat
 from vrlib.tolerance import render_within
 from vrlib.volume import Volume
 
-__all__ = ["render", "METHODS", "method_options", "reference_image"]
+__all__ = ["render", "METHODS", "method_options", "chosen_method", "reference_image"]
 
 #: The finest ray cast, the most accurate image vrlib makes of a volume without its field.
 FINE = {"filter": "catmull-rom", "step": 0.125, "early_termination": 1.0}
@@ -54,6 +54,19 @@ def method_options(method):
     {'mode': 'sheet', 'footprint_resolution': 129, 'slab_width': 1.0}
     """
     return dict(_own_options(method))
+
+
+def chosen_method(method):
+    """The method :func:`render` runs for ``method``: ``"auto"`` is ray casting, the one
+    method that renders to a tolerance (a choice between methods by the cost model is not
+    built).
+
+    Examples
+    --------
+    >>> chosen_method("auto"), chosen_method("splat")
+    ('raycast', 'splat')
+    """
+    return "raycast" if method == "auto" else method
 
 
 @functools.cache
@@ -149,7 +162,7 @@ def render(volume, view, *, method="raycast", filter="trilinear", transfer=None,
         transfer = auto_transfer(volume)
     if tolerance is not None:
         _check_tolerance_arguments(method, step, early_termination, blend, options)
-    method = "raycast" if method == "auto" else method
+    method = chosen_method(method)
     step = 0.5 if step is None else step
     early_termination = 0.999 if early_termination is None else early_termination
     filt, transfer, step, early_termination = render_arguments(view, filter, transfer, step,
