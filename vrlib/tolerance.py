@@ -27,6 +27,11 @@ How it is kept (docs/kernel.md):
   never coarser than the pilot's coarsest. The pilot goes on halving while the step it
   predicts lies below half its finest step, so the prediction never reaches far past what it
   measured.
+* On a large image (:data:`LONGER_PIXELS` times the pilot's pixels) whose step reached the
+  pilot's first, longer steps are tried up to :data:`LONGEST_STEP`: each doubling is one more
+  pilot, and is taken while the error at the last step plus the difference between the two
+  pilots (a bound by the triangle inequality, with no order of convergence assumed) stays
+  within the share.
 * A tolerance that would need a step below :data:`MIN_STEP` voxel is refused, with the
   error that step reaches, never answered with a worse image.
 
@@ -44,7 +49,8 @@ from vrlib import validate
 from vrlib.raycast import brightest, render_raycast
 from vrlib.value_bounds import reconstructed_range
 
-__all__ = ["render_within", "finest_error", "TERM_SHARE", "STEP_SHARE", "MIN_STEP", "MAX_STEP"]
+__all__ = ["render_within", "finest_error", "TERM_SHARE", "STEP_SHARE", "MIN_STEP", "MAX_STEP",
+           "LONGEST_STEP", "LONGER_PIXELS"]
 
 #: How a render to a tolerance classifies its segments. Measured on the chapter's matrix
 #: (96^2): point sampling with exact ends kept every promise pre-integration kept, in 1.0 to
@@ -58,7 +64,8 @@ TERM_SHARE = 0.05
 STEP_SHARE = 0.8
 #: Smallest step (voxels) a tolerance may ask for.
 MIN_STEP = 1.0 / 256.0
-#: Largest step (voxels) a tolerance may be given: the pilot's first.
+#: The pilot's first step (voxels), and the largest a tolerance may be given unless the
+#: image is large (:data:`LONGEST_STEP`).
 MAX_STEP = 2.0
 #: Pilot images have this many times fewer pixels per axis than the image, at least
 #: :data:`PILOT_MIN` and at most :data:`PILOT_MAX` a side: their rays sample the image's
@@ -68,6 +75,12 @@ MAX_STEP = 2.0
 PILOT_SHRINK = 4
 PILOT_MIN = 32
 PILOT_MAX = 64
+#: Steps longer than :data:`MAX_STEP`, up to this (voxels), are tried where the image has at
+#: least :data:`LONGER_PIXELS` times the pilot's pixels: there one more pilot costs less
+#: than the samples a doubled step saves (a rule on sizes, not timings, so that the image
+#: never depends on the machine).
+LONGEST_STEP = 16.0
+LONGER_PIXELS = 32
 
 
 def render_within(volume, view, *, filt, transfer, tolerance, empty_space_skipping=True):
@@ -113,10 +126,11 @@ def render_within(volume, view, *, filt, transfer, tolerance, empty_space_skippi
     target = STEP_SHARE * tolerance
     steps, differences, alignments = [], [], []
     step = MAX_STEP
-    previous = change = predicted = None
+    previous = change = predicted = coarsest = None
     while True:
         steps.append(step)
         pilot = render_raycast(volume, pilot_view, step=step, **options).rgba
+        coarsest = pilot if coarsest is None else coarsest
         if previous is not None:
             last_change, change = change, previous - pilot
             differences.append(float(np.sqrt(np.mean(change * change))))
@@ -160,9 +174,25 @@ def render_within(volume, view, *, filt, transfer, tolerance, empty_space_skippi
             f"along rays is still about {reach:.2g}; ask for a tolerance of at least "
             f"{reach / STEP_SHARE:.2g}")
     step = float(min(predicted, MAX_STEP))
+    error = error_at(step)
+    longer = []
+    if (step == MAX_STEP and view.height * view.width
+            >= LONGER_PIXELS * pilot_view.height * pilot_view.width):
+        # Longer steps: each doubling is one more pilot, compared with the last step's. The
+        # error at the doubled step is at most the error at the last plus their difference
+        # (the triangle inequality, no order of convergence assumed where a long step may
+        # not resolve the field), so a doubling is taken while that sum meets the share.
+        last = coarsest
+        while 2.0 * step <= LONGEST_STEP:
+            doubled = render_raycast(volume, pilot_view, step=2.0 * step, **options).rgba
+            change = doubled - last
+            longer.append(float(np.sqrt(np.mean(change * change))))
+            if error + longer[-1] > target:
+                break
+            error, last, step = error + longer[-1], doubled, 2.0 * step
     pilot_seconds = time.perf_counter() - start
     image = render_raycast(volume, view, step=step, **options)
-    estimate = error_at(step) + TERM_SHARE * tolerance
+    estimate = error + TERM_SHARE * tolerance
     image.stats.seconds = time.perf_counter() - start
     image.stats.choices = {
         "tolerance": tolerance, "method": "raycast", "filter": filt.name, "step": step,
@@ -170,7 +200,7 @@ def render_within(volume, view, *, filt, transfer, tolerance, empty_space_skippi
         "early_termination": early_termination, "skip_budget": 0.0, "estimate": estimate,
         "pilot": {"shape": list(pilot_view.shape), "steps": steps,
                   "differences": differences, "alignments": alignments,
-                  "checked": checked, "seconds": pilot_seconds},
+                  "checked": checked, "longer": longer, "seconds": pilot_seconds},
     }
     return image
 
