@@ -25,6 +25,7 @@ def blobs():
 TRANSFERS = {
     "glow": vrlib.Glow(4.0),
     "shaded": vrlib.Glow(4.0, shading=vrlib.Phong(specular=0.4)),
+    "colour": vrlib.LookupTransfer([0, 2, 8], color=[[1, 0, 0], [0, 1, 0], [0.2, 0.3, 1]]),
     "colour, shaded, by gradient": vrlib.LookupTransfer(
         [0, 2, 8], color=[[1, 0, 0], [0, 1, 0], [0.2, 0.3, 1]], shading=vrlib.Phong(),
         gradient_opacity=vrlib.GradientOpacity([0.5, 3.0], [0.0, 1.0])),

@@ -297,7 +297,8 @@ class ClassifiedVolume:
         bands = (self._band_order(axis, dj, height) if threads > 1 else
                  np.arange(-(-height // BAND)))
         arguments = (*encoded, n_j, order, di, dj, length, self._emission, factor,
-                     highlight, self._grey, shading is not None, threshold, BAND, bands,
+                     highlight, True if self._grey else None,
+                     True if shading is not None else None, threshold, BAND, bands,
                      np.zeros(1, np.int64), inter, counts)
         on_threads(lambda i: composite_classified(*arguments), threads)
         plane = volume.origin[axis] + kf * volume.spacing[axis]
