@@ -134,6 +134,7 @@ def warp_homography(view, volume, axis, plane, offsets):
     pixel = view.plane_pixel
     h, origin = volume.spacing.tolist(), volume.origin.tolist()
     start = view.start.tolist()
+    eye = start  # perspective: rays start at the eye
     rows = []
     for col, row in [(0, 0), (1, 0), (0, 1)]:
         along, down = col + 0.5 - 0.5 * view.width, 0.5 * view.height - row - 0.5
@@ -147,7 +148,6 @@ def warp_homography(view, volume, axis, plane, offsets):
                          + offsets[1], 1.0])
             continue
         # eye + (plane - eye_axis) / d_axis * d, scaled by d_axis (> 0 toward the plane)
-        eye = start
         direction = [f + (along * r + down * u) * pixel
                      for f, r, u in zip(forward, right, up, strict=True)]
         sign = math.copysign(1.0, plane - eye[axis])
