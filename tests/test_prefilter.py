@@ -2,6 +2,7 @@
 rule, scipy agreement, numerical range."""
 
 import math
+import os
 
 import numpy as np
 import pytest
@@ -125,3 +126,40 @@ def test_every_method_counts_what_its_prefilter_costs():
         assert later.stats.prefilter["cached"] == (per_frame == 0)
         assert per_frame < first.stats.prefilter["samples"]
         assert vrlib.render(vol, view, method=method).stats.prefilter is None
+
+
+def test_python_threads_take_turns_in_the_parallel_kernels():
+    """numba's workqueue threading layer (its fallback without TBB or OpenMP, and the
+    Makefile's) aborts the whole process when two Python threads run parallel regions at once;
+    vrlib's parallel kernels are launched one at a time
+    (:data:`vrlib._kernels._jit.PARALLEL_LAUNCH`), so four threads prefiltering at once finish,
+    each with the serial answer. Without the lock this process aborts within its first
+    rounds."""
+    import subprocess
+    import sys
+
+    code = """
+import threading
+import numpy as np
+from vrlib.prefilter import coefficients
+rng = np.random.default_rng(0)
+data = [rng.random((12, 10, 14)) for _ in range(4)]
+pole = [3.0 ** 0.5 - 2.0]
+expected = [coefficients(d, pole) for d in data]
+wrong = []
+def work(i):
+    for _ in range(200):
+        if not np.array_equal(coefficients(data[i], pole), expected[i]):
+            wrong.append(i)
+threads = [threading.Thread(target=work, args=(i,)) for i in range(4)]
+for t in threads:
+    t.start()
+for t in threads:
+    t.join()
+print("wrong", len(wrong))
+"""
+    env = {**os.environ, "NUMBA_THREADING_LAYER": "workqueue"}
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                          env=env, timeout=300, check=False)
+    assert done.returncode == 0, done.stderr[-2000:]
+    assert "wrong 0" in done.stdout

@@ -15,6 +15,7 @@ Running the suite with ``NUMBA_DISABLE_JIT=1`` executes these same functions as 
 from __future__ import annotations
 
 import functools
+import threading
 
 import numba
 import numba.cpython.unsafe.numbers
@@ -25,10 +26,35 @@ from numba.extending import intrinsic
 jit = functools.partial(numba.njit, cache=True, nogil=True, error_model="numpy")
 """Serial kernel decorator."""
 
-parallel_jit = functools.partial(
-    numba.njit, cache=True, nogil=True, error_model="numpy", parallel=True
-)
-"""Kernel decorator for loops over independent work (``numba.prange``)."""
+#: Held through every launch of a parallel kernel: numba's ``workqueue`` threading layer
+#: (numba's fallback without TBB or OpenMP, and the Makefile's) aborts the whole process when
+#: two Python threads run parallel regions at once, so renders on several threads take
+#: turns in these kernels (the serial kernels on ``vrlib._scheduling.on_threads`` do not
+#: need it).
+PARALLEL_LAUNCH = threading.Lock()
+
+
+class _LaunchedAlone:
+    """A parallel kernel called from Python under :data:`PARALLEL_LAUNCH`; every other
+    attribute is the numba dispatcher's."""
+
+    def __init__(self, dispatcher):
+        self._dispatcher = dispatcher
+        functools.update_wrapper(self, dispatcher)
+
+    def __call__(self, *args, **kwargs):
+        with PARALLEL_LAUNCH:
+            return self._dispatcher(*args, **kwargs)
+
+    def __getattr__(self, name):
+        return getattr(self._dispatcher, name)
+
+
+def parallel_jit(function):
+    """Kernel decorator for loops over independent work (``numba.prange``), launched from
+    Python one at a time (:data:`PARALLEL_LAUNCH`)."""
+    return _LaunchedAlone(numba.njit(function, cache=True, nogil=True, error_model="numpy",
+                                     parallel=True))
 
 helper_jit = functools.partial(jit, no_cpython_wrapper=True)
 """Decorator of a helper that only compiled code calls: numba builds it no Python wrapper
