@@ -40,7 +40,7 @@ class _LaunchedAlone:
 
     def __init__(self, dispatcher):
         self._dispatcher = dispatcher
-        functools.update_wrapper(self, dispatcher)
+        functools.update_wrapper(self, dispatcher, updated=())  # its name and docstring
 
     def __call__(self, *args, **kwargs):
         with PARALLEL_LAUNCH:
