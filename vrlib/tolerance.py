@@ -133,7 +133,7 @@ def render_within(volume, view, *, filt, transfer, tolerance, empty_space_skippi
         coarsest = pilot if coarsest is None else coarsest
         if previous is not None:
             last_change, change = change, previous - pilot
-            differences.append(float(np.sqrt(np.mean(change * change))))
+            differences.append(_rms(change))
             if last_change is not None:
                 alignments.append(float(np.mean(last_change * change)))
         previous = pilot
@@ -186,7 +186,7 @@ def render_within(volume, view, *, filt, transfer, tolerance, empty_space_skippi
         while 2.0 * step <= LONGEST_STEP:
             doubled = render_raycast(volume, pilot_view, step=2.0 * step, **options).rgba
             change = doubled - last
-            longer.append(float(np.sqrt(np.mean(change * change))))
+            longer.append(_rms(change))
             if error + longer[-1] > target:
                 break
             error, last, step = error + longer[-1], doubled, 2.0 * step
@@ -203,6 +203,12 @@ def render_within(volume, view, *, filt, transfer, tolerance, empty_space_skippi
                   "checked": checked, "longer": longer, "seconds": pilot_seconds},
     }
     return image
+
+
+def _rms(difference):
+    """The rmse of two pilot images from their difference (:func:`vrlib.metrics.rmse`'s
+    number; the difference itself is kept, for the next one's alignment)."""
+    return float(np.sqrt(np.mean(difference * difference)))
 
 
 def _first_order_bound(difference):
