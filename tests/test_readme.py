@@ -98,6 +98,7 @@ def test_readme_tolerance_example_prints_what_it_says(capsys):
     assert capsys.readouterr().out.split() == ["True", "True"]
 
 
+@pytest.mark.slow  # each picture's command in a cold process (20 s): keeps make test under 5 min
 def test_readme_pictures_are_what_their_commands_make(tmp_path):
     import imageio.v3 as iio
 
