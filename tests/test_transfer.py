@@ -4,6 +4,7 @@ import numpy as np
 import pytest
 
 from vrlib import Glow, LookupTransfer, Phong
+from vrlib.transfer import range_maximum
 
 VALUES = np.linspace(-0.5, 2.5, 61)
 
@@ -60,6 +61,18 @@ def test_table_max_density_bounds_every_value_in_range():
         bound = tf.max_density(lo, hi)
         assert bound >= tf.opacity_density(inside).max() - 1e-12
         assert bound == pytest.approx(tf.opacity_density(inside).max(), abs=0.05)
+
+
+@pytest.mark.parametrize("count", [1, 2, 4, 5, 40])
+def test_range_maximum_is_each_intervals_maximum(count):
+    """A few intervals are read one by one, more from the sparse table: both give each
+    interval's maximum exactly."""
+    rng = np.random.default_rng(count)
+    values = rng.random(257)
+    first = rng.integers(0, 256, count)
+    last = first + 1 + rng.integers(0, 257 - first)
+    expected = [values[a:b].max() for a, b in zip(first, last, strict=True)]
+    assert range_maximum(values, first, last).tolist() == expected
 
 
 def test_from_alpha_matches_vtk_opacity_units():

@@ -20,6 +20,7 @@ from typing import NamedTuple
 import numpy as np
 
 from vrlib._kernels import coverage as _coverage
+from vrlib._kernels._jit import readonly
 from vrlib.value_bounds import value_bounds
 
 __all__ = ["BLOCK", "SkipGrid", "skip_grid", "block_densities", "empty_blocks",
@@ -231,11 +232,10 @@ def footprint_mask(view, lattice, empty, block):
     False
     """
     mask = np.zeros(view.shape, dtype=bool)
-    full = np.argwhere(~empty)[:, ::-1]  # block indices, x y z
-    if full.size == 0:
+    if empty.all():
         return mask
     vector = np.ascontiguousarray
-    if not _coverage.cover(view.packed(), vector(full, np.int64), int(block),
+    if not _coverage.cover(view.packed(), readonly(vector(empty, bool)), int(block),
                            np.array(lattice.shape[::-1], np.int64) - 1,
                            vector(lattice.origin, np.float64),
                            vector(lattice.spacing, np.float64),

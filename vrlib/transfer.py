@@ -467,8 +467,14 @@ class Glow(TransferFunction):
         return f"Glow({self.scale:g}{_extras_repr(self)})"
 
 
+#: Intervals that :func:`range_maximum` reads one by one rather than build its sparse table.
+_FEW_INTERVALS = 4
+
+
 def range_maximum(values, first, last):
-    """``max(values[first:last])`` for arrays of ``first < last`` (a sparse table).
+    """``max(values[first:last])`` for arrays of ``first < last``: from a sparse table, or,
+    for a few intervals (a render's check of its value range), read directly (building the
+    table cost 60 microseconds a render for a table of 4096 entries).
 
     Examples
     --------
@@ -476,7 +482,12 @@ def range_maximum(values, first, last):
     array([5., 2.])
     """
     first, last = np.asarray(first), np.asarray(last)
-    table = [np.asarray(values, dtype=np.float64)]  # table[lev][i] = max(values[i:i+2^lev])
+    values = np.asarray(values, dtype=np.float64)
+    if first.size <= _FEW_INTERVALS:
+        return np.array([values[a:b].max() for a, b in zip(first.ravel().tolist(),
+                                                           last.ravel().tolist(), strict=True)],
+                        dtype=np.float64).reshape(first.shape)
+    table = [values]  # table[lev][i] = max(values[i:i+2^lev])
     span = 1
     while 2 * span <= table[0].shape[0]:
         table.append(np.maximum(table[-1][:-span], table[-1][span:]))
@@ -566,10 +577,13 @@ class LookupTransfer(TransferFunction):
         made.unit_distance = unit  # the projections classify one value over this distance
         return made
 
-    def _interp(self, table, values):
+    def _grid(self, table):
+        """The values at which ``table``'s entries lie."""
+        return np.linspace(*self.value_range, table.shape[0])
+
+    def _interp(self, table, values, grid=None):
         values = np.asarray(values, dtype=np.float64)
-        grid = np.linspace(*self.value_range, table.shape[0])
-        return np.interp(values, grid, table)
+        return np.interp(values, self._grid(table) if grid is None else grid, table)
 
     def opacity_density(self, values):
         return self._interp(self.density, values)
@@ -579,7 +593,9 @@ class LookupTransfer(TransferFunction):
         return (*self.value_range, self.density.shape[0] - 1)
 
     def emission(self, values):
-        return np.stack([self._interp(self.color[:, c], values) for c in range(3)], axis=-1)
+        grid = self._grid(self.color)
+        return np.stack([self._interp(self.color[:, c], values, grid) for c in range(3)],
+                        axis=-1)
 
     def max_density(self, vmin, vmax):
         vmin, vmax = np.broadcast_arrays(np.asarray(vmin, float), np.asarray(vmax, float))
@@ -587,8 +603,9 @@ class LookupTransfer(TransferFunction):
         vmin, vmax = np.atleast_1d(vmin), np.atleast_1d(vmax)
         # The interpolated function peaks at an end of the interval or at a table entry
         # strictly inside it; the entries' maximum comes from a sparse table (range maximum).
-        best = np.maximum(self.opacity_density(vmin), self.opacity_density(vmax))
-        grid = np.linspace(*self.value_range, self.density.shape[0])
+        grid = self._grid(self.density)
+        best = np.maximum(self._interp(self.density, vmin, grid),
+                          self._interp(self.density, vmax, grid))
         first = np.searchsorted(grid, vmin, side="right")
         last = np.searchsorted(grid, vmax, side="left")  # entries first .. last - 1
         has = last > first
