@@ -191,8 +191,10 @@ def test_an_unreachable_tolerance_is_refused_with_what_is_reachable():
 
 
 def test_a_memo_shared_between_renders_changes_no_image():
-    """The pilot's renders share the footprint of the volume's skip grid (``memo``); each
-    image equals the one rendered without it, for several steps and two views in turn."""
+    """The pilot's renders share what does not depend on the step (``memo``: the footprint
+    of the volume's skip grid, the kernel's plan); each image equals the one rendered
+    without it, for several steps and two views in turn, and the plan is built once per
+    view."""
     from vrlib.filters import make_filter
     from vrlib.raycast import render_raycast
 
@@ -201,11 +203,15 @@ def test_a_memo_shared_between_renders_changes_no_image():
     ramp = LookupTransfer(np.clip(np.linspace(-4.0, 16.0, 101), 0.0, None))  # empty blocks
     options = dict(filt=make_filter("trilinear"), transfer=ramp, early_termination=1.0,
                    empty_space_skipping=True, segment_ends="exact")
-    memo = {}
+    memo, plans = {}, []
     for view in views:
         for step in (2.0, 1.0, 0.5):
             shared = render_raycast(vol, view, step=step, memo=memo, **options)
             alone = render_raycast(vol, view, step=step, **options)
             assert np.array_equal(shared.rgba, alone.rgba)
             assert shared.alpha.max() > 0.2
-    assert memo["view"] is views[-1] and memo["grid"].empty.any() and memo["mask"].any()
+            plans.append(memo["ray plan"][1])
+    assert [len({id(plan) for plan in plans[n:n + 3]}) for n in (0, 3)] == [1, 1]
+    assert plans[0] is not plans[3]
+    assert memo["grid"][1].empty.any() and memo["mask"][0][0] is views[-1]
+    assert memo["mask"][1].any() and not memo["mask"][1].all()

@@ -10,7 +10,9 @@ ray termination stops a ray once its opacity reaches a threshold (the image chan
 
 from __future__ import annotations
 
+import functools
 import time
+from typing import NamedTuple
 
 import numba
 import numpy as np
@@ -98,9 +100,10 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
 
     The skip grid (the blocks' densities, which are empty, how far each is from a block of
     the other kind) is kept with the volume (:func:`vrlib.skipping.skip_grid`). ``memo`` (a
-    dict, empty at first) keeps what depends on the view as well (the pixels whose rays can
-    meet a block) between renders of one scene at several steps: a render to a tolerance's
-    pilot images. The images are the same with it or without.
+    dict, empty at first) keeps what does not depend on the step (the pixels whose rays can
+    meet a block, the tiles' order, the kernel's arguments: :class:`RayPlan`) between
+    renders of one volume, filter and transfer function, unchanged, at several steps: a
+    render to a tolerance's pilot images. The images are the same with it or without.
     """
     skip_budget = validate.finite_number("skip_budget", skip_budget, low=0.0)
     step_budget = validate.finite_number("step_budget", step_budget, low=0.0)
@@ -120,16 +123,18 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
     start = time.perf_counter()
     tally = Tally()
     volume = prepared(volume, filt, tally)  # prefiltered filters: the 3-D coefficients
+    memo = {} if memo is None else memo
+    kept = functools.partial(_kept, memo)
     extent = volume.extent
-    box_lo, box_hi = extent[:, 0].copy(), extent[:, 1].copy()
+    box_lo, box_hi = kept("box", (volume,), lambda: (extent[:, 0].copy(), extent[:, 1].copy()))
     ds = step * float(volume.spacing.min())
-    value_range = reconstructed_range(volume, filt)
+    value_range = kept("range", (volume, filt), lambda: reconstructed_range(volume, filt))
     skip = bound = multiplier = None
     if skip_budget > 0.0 and not empty_space_skipping:
         raise ValueError("skip_budget > 0 skips blocks: it needs empty_space_skipping=True")
-    memo = {} if memo is None else memo
     if empty_space_skipping:
-        grid = skip_grid(volume, filt, transfer, block=BLOCK)
+        grid = kept("grid", (volume, filt, transfer),
+                    lambda: skip_grid(volume, filt, transfer, block=BLOCK))
         densities, empty = grid.densities, grid.empty
         if skip_budget > 0.0:
             bound = skip_bounds(densities, volume, transfer, ds, value_range)
@@ -143,21 +148,21 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
         # With nothing to skip or stretch, checking would only cost time.
         if (empty.any() or (bound is not None and np.any(bound <= skip_budget))
                 or multiplier is not None):
-            box_lo, box_hi = visible_box(volume, empty, BLOCK, box_lo, box_hi)
+            box_lo, box_hi = kept("visible box", (grid, box_lo, box_hi),
+                                  lambda: visible_box(volume, empty, BLOCK, box_lo, box_hi))
             if preint:  # a segment owned outside the box reaches half a step into it
                 box_lo = np.maximum(box_lo - 0.5 * ds, extent[:, 0])
                 box_hi = np.minimum(box_hi + 0.5 * ds, extent[:, 1])
-            if memo.get("view") is not view or memo.get("grid") is not grid:
-                memo["view"], memo["grid"] = view, grid
-                memo["mask"] = footprint_mask(view, volume, empty, BLOCK)
-            skip = (empty, grid.clearance, BLOCK, memo["mask"])
+            skip = (empty, grid.clearance, BLOCK,
+                    kept("mask", (view, grid), lambda: footprint_mask(view, volume, empty,
+                                                                      BLOCK)))
     rgba, taken = cast_rays(
         volume.data, offset=(0, 0, 0), global_shape=volume.shape, origin=volume.origin,
         spacing=volume.spacing, box=(box_lo, box_hi), view=view, filt=filt, transfer=transfer,
         ds=ds, value_range=value_range,
         early_termination=early_termination, skip=skip, exact_ends=exact,
         preintegrated=preint, bound=bound, budget=skip_budget, multiplier=multiplier,
-    )
+        memo=memo)
     stats = RenderStats(
         samples=taken,
         operations=taken * operations_per_sample(filt, shading=transfer.needs_gradient),
@@ -238,7 +243,7 @@ def brightest(transfer, value_range):
 
 def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, transfer, ds,
               value_range, early_termination, skip=None, exact_ends=False,
-              preintegrated=False, bound=None, budget=0.0, multiplier=None):
+              preintegrated=False, bound=None, budget=0.0, multiplier=None, memo=None):
     """Ray-cast samples ``data`` (all of a volume, or a brick of it with ghost samples): the
     ray caster's core, which the MPI renderers run on each brick or tile.
 
@@ -271,6 +276,9 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
     multiplier : ndarray of int or None
         Per block of the skip grid, how many steps one sample may stand for (adaptive steps,
         :func:`vrlib.adaptive.step_multipliers`; point classification only), or None.
+    memo : dict or None
+        Keeps what does not depend on the step (:class:`RayPlan`) between calls that give
+        the same objects for all else: renders of one scene at several steps.
 
     Returns
     -------
@@ -278,7 +286,84 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
     samples : int
         Samples reconstructed.
     """
-    tables = None if preintegrated else transfer.segment_table(ds, *value_range)
+    plan = _ray_plan(data, offset, global_shape, origin, spacing, box, view, filt, transfer,
+                     skip, memo)
+    vector = np.ascontiguousarray
+    out = np.zeros(view.shape + (4,))
+    samples = np.zeros(plan.tiles, dtype=np.int64)
+    skips = (early_termination, *plan.grids,
+             readonly(vector(_NO_BOUND if bound is None else bound, np.float64)), float(budget))
+    # The tiles, heaviest first, behind a queue that every thread takes the next one from.
+    tiles = (*TILE, plan.order, np.zeros(1, np.int64), out, samples)
+    if preintegrated:
+        profile = "step" if filt.radius <= 0.5 else "linear"  # the box filter jumps
+        arguments = (*plan.layout, view.packed(), view.height, view.width, ds, *filt.code,
+                     filt.radius, filt.taps,
+                     *transfer.preintegrated_table(ds, *value_range, profile=profile),
+                     *plan.lighting, *plan.by_gradient, *skips, *tiles)
+        on_threads(lambda i: _kernel.raycast_preintegrated(*arguments, plan.scratch[i]),
+                   plan.threads)
+    else:
+        tables = transfer.segment_table(ds, *value_range)
+        # Colour equals opacity: white emission, no shading.
+        grey = transfer.shading is None and bool(np.all(tables[4] == 1.0))
+        arguments = (*plan.layout, bool(exact_ends), view.packed(), view.height, view.width,
+                     ds, *filt.code, filt.radius, filt.taps, *tables, *plan.lighting,
+                     *plan.by_gradient, *skips,
+                     readonly(vector(_NO_MULTIPLIER if multiplier is None else multiplier,
+                                     np.int64)),
+                     *tiles, grey, *plan.kind)
+        on_threads(lambda i: _kernel.raycast(*arguments, plan.scratch[i],
+                                             *(a[i] for a in plan.lanes)), plan.threads)
+    return out, int(samples.sum())  # the kernels clip each pixel's opacity
+
+
+#: Stand-ins for the kernels' arrays a render does not use (read-only: shared by every render).
+_NO_BOUND = readonly(np.zeros((1, 1, 1)))
+_NO_MULTIPLIER = readonly(np.ones((1, 1, 1), np.int64))
+
+
+class RayPlan(NamedTuple):
+    """What :func:`cast_rays` hands its kernel that does not depend on the step."""
+
+    #: The samples and the lattice: data, offset, global shape, origin, spacing, the box's
+    #: corners and the whole volume's.
+    layout: tuple
+    lighting: tuple
+    by_gradient: tuple
+    #: The skip grids (empty, clearance, block, pixel mask), as the kernel takes them.
+    grids: tuple
+    #: The tiles whose pixels' rays can meet something, heaviest first; how many tiles the
+    #: image has.
+    order: np.ndarray
+    tiles: int
+    threads: int
+    #: Each thread's scratch for the filter's weights, and its lanes (:func:`_kernel.lanes`).
+    scratch: np.ndarray
+    lanes: tuple
+    #: The kernel compiled for this kind of render (``filtering, lit, skipping, packets``):
+    #: the tent filter, no shading or gradient opacity, a volume with nothing to skip, make a
+    #: smaller kernel, a shorter first wait.
+    kind: tuple
+
+
+def _ray_plan(data, offset, global_shape, origin, spacing, box, view, filt, transfer, skip,
+              memo):
+    """:func:`cast_rays`'s :class:`RayPlan`, kept in ``memo`` (a dict, or None) while the
+    samples, view, box, filter, transfer function and skip grids are the same objects and
+    the thread count the same (a render to a tolerance's pilot images at several steps:
+    0.1 ms each at 32^2)."""
+    threads = numba.get_num_threads()
+    key = (data, tuple(offset), tuple(global_shape), tuple(np.asarray(origin).tolist()),
+           tuple(np.asarray(spacing).tolist()), view, box[0], box[1], filt, transfer,
+           threads) + (() if skip is None else tuple(skip))
+    return _kept({} if memo is None else memo, "ray plan", key, lambda: _build_plan(
+        data, offset, global_shape, origin, spacing, box, view, filt, transfer, skip, threads))
+
+
+def _build_plan(data, offset, global_shape, origin, spacing, box, view, filt, transfer, skip,
+                threads):
+    """:func:`_ray_plan`'s plan, built."""
     shading = transfer.shading
     if shading is None:
         lighting = (False, 0.0, 0.0, 0.0, 1.0, np.zeros(3), True)
@@ -296,9 +381,7 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
     ramp = transfer.gradient_opacity
     by_gradient = (np.zeros(2), np.zeros(2), False) if ramp is None else (
         ramp.magnitudes, ramp.factors, True)
-    out = np.zeros(view.shape + (4,))
     rows, cols = -(-view.height // TILE[0]), -(-view.width // TILE[1])
-    samples = np.zeros(rows * cols, dtype=np.int64)
     # Cost of a tile: the pixels whose rays can meet something visible; the threads take the
     # heaviest tiles first. Tiles without such a pixel stay transparent and are not handed
     # out at all.
@@ -315,40 +398,33 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
               vector(origin, np.float64), vector(spacing, np.float64),
               vector(box[0], np.float64), vector(box[1], np.float64),
               *lattice_extent(global_shape, spacing, origin).T.copy())
-    skips = (early_termination, readonly(vector(empty, bool)),
-             readonly(vector(clearance, np.int64)), block, readonly(vector(mask, bool)),
-             readonly(vector(np.zeros((1, 1, 1)) if bound is None else bound, np.float64)),
-             float(budget))
-    # The tiles, heaviest first, behind a queue that every thread takes the next one from;
-    # each thread's own scratch for the filter's weights (rows of MAX_TAPS = 8 floats, a
-    # cache line; an unused row between two threads' keeps them off each other's lines).
-    tiles = (*TILE, live[np.argsort(-costs[live], kind="stable")], np.zeros(1, np.int64),
-             out, samples)
-    threads = numba.get_num_threads()
-    scratch = np.zeros((threads, 7, MAX_TAPS))[:, :6]
-    if preintegrated:
-        profile = "step" if filt.radius <= 0.5 else "linear"  # the box filter jumps
-        arguments = (*layout, view.packed(), view.height, view.width, ds, *filt.code,
-                     filt.radius, filt.taps,
-                     *transfer.preintegrated_table(ds, *value_range, profile=profile),
-                     *lighting, *by_gradient, *skips, *tiles)
-        on_threads(lambda i: _kernel.raycast_preintegrated(*arguments, scratch[i]), threads)
-    else:
-        grey = shading is None and bool(np.all(tables[4] == 1.0))  # colour equals opacity
-        # The kernel compiled for this kind of render (the tent filter, no shading or
-        # gradient opacity, a volume with nothing to skip: a smaller kernel, a shorter first
-        # wait).
-        filtering = None if filt.code[0] == TENT else True
-        lit = None if shading is None and ramp is None else True
-        skipping = None if block == 0 else True
-        arguments = (*layout, bool(exact_ends), view.packed(), view.height, view.width, ds,
-                     *filt.code, filt.radius, filt.taps, *tables, *lighting, *by_gradient,
-                     *skips,
-                     readonly(vector(np.ones((1, 1, 1)) if multiplier is None else multiplier,
-                                     np.int64)),
-                     *tiles, grey, filtering, lit, skipping,
-                     True if filtering is None and lit is None else None)
-        lanes = _kernel.lanes(threads)
-        on_threads(lambda i: _kernel.raycast(*arguments, scratch[i], *(a[i] for a in lanes)),
-                   threads)
-    return out, int(samples.sum())  # the kernels clip each pixel's opacity
+    grids = (readonly(vector(empty, bool)), readonly(vector(clearance, np.int64)), block,
+             readonly(vector(mask, bool)))
+    filtering = None if filt.code[0] == TENT else True
+    lit = None if shading is None and ramp is None else True
+    return RayPlan(layout, lighting, by_gradient, grids,
+                   live[np.argsort(-costs[live], kind="stable")], rows * cols, threads,
+                   # Rows of MAX_TAPS = 8 floats, a cache line; an unused row between two
+                   # threads' keeps them off each other's lines.
+                   np.zeros((threads, 7, MAX_TAPS))[:, :6], _kernel.lanes(threads),
+                   (filtering, lit, None if block == 0 else True,
+                    True if filtering is None and lit is None else None))
+
+
+def _kept(memo, name, key, build):
+    """``build()``, kept in ``memo`` under ``name`` while ``key`` names the same objects
+    (:func:`_same`)."""
+    held = memo.get(name)
+    if held is not None and _same(held[0], key):
+        return held[1]
+    value = build()
+    memo[name] = (key, value)
+    return value
+
+
+def _same(held, key):
+    """Whether the key ``held`` names the same objects as ``key`` (numbers and tuples of
+    them: equal ones)."""
+    return len(held) == len(key) and all(
+        a is b or (type(a) is type(b) and isinstance(a, (int, tuple)) and a == b)
+        for a, b in zip(held, key, strict=True))
