@@ -233,8 +233,7 @@ def brightest(transfer, value_range):
     >>> brightest(Glow(1.0, shading=Phong(ambient=0.3, diffuse=0.7, specular=0.5)), (0, 1))
     1.5
     """
-    _, _, _, emission = transfer.value_table(*value_range)
-    most = float(emission.max())
+    most = transfer.brightest_emission(*value_range)
     shading = transfer.shading
     if shading is not None:
         most = most * (shading.ambient + shading.diffuse) + shading.specular

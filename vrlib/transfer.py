@@ -361,6 +361,20 @@ class TransferFunction:
         inverse_step = (values.size - 1) / (stop - start)
         return start, inverse_step, self.opacity_density(values), self.emission(values)
 
+    def brightest_emission(self, low, high):
+        """The largest value of any channel of the emission on :meth:`value_table`'s grid
+        for ``[low, high]`` (which covers that interval, so that this bounds the emission
+        there; exact on its linear pieces), kept as the tables are.
+
+        Examples
+        --------
+        >>> LookupTransfer([1.0, 1.0], [[0.5, 2.0, 0.0], [0.5, 0.0, 0.0]]).brightest_emission(
+        ...     0.0, 1.0)
+        2.0
+        """
+        return self._kept(("brightest", float(low), float(high)),
+                          lambda: float(self.value_table(low, high)[3].max()))
+
 
 _TABLES = weakref.WeakKeyDictionary()  # tables kept per transfer function (_kept)
 _TABLES_KEPT = 24
