@@ -361,6 +361,9 @@ def render_splat(volume, view, *, filt, transfer, step, early_termination, empty
         empty_space_skipping, first, last, near if view.is_perspective else -math.inf,
         reach_max, BAND,
         np.arange(bands), np.zeros(1, np.int64), out, voxels, pixels,
+        # The kernel compiled for this kind of render: an orthographic or unlit one compiles
+        # none of the other's code.
+        True if view.is_perspective else None, True if lighting else None,
     )
     # Each thread's own scratch: a band's sheets and per-pixel records, the cuts of the
     # exact footprints.

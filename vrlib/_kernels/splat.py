@@ -129,7 +129,7 @@ def _deposit(mode, f, fp, dens, er, eg, eb, threshold, sheet, touched, opaque, o
     if mode != DIRECT:
         sheet[r - r0, c] += f * fp
         touched[r - r0, c] = True
-        if lighting:
+        if lighting is not None:
             gsheet[0, r - r0, c] += g0 * fp
             gsheet[1, r - r0, c] += g1 * fp
             gsheet[2, r - r0, c] += g2 * fp
@@ -305,8 +305,8 @@ def _flush(mode, s, r0, r1, width, axis, origin, spacing, radius, cumulative, z_
     all slices, ghosts included, sum to the stretch); a share under a quarter of a slab's
     length (the slice near where the ray enters or leaves) is held for the next slice, and
     what is held at the end is composited after the last one (over its own share, which may
-    be negative for kernels with negative lobes). With ``lighting`` the segment is
-    classified by its mean gradient too (the gradient sheets ``gsheet`` over its length),
+    be negative for kernels with negative lobes). With ``lighting`` (True; None compiles the
+    gradients away) the segment is classified by its mean gradient too (the gradient sheets ``gsheet`` over its length),
     seen along the pixel's ray (``camera``, an image ``height`` rows high).
     """
     for r in range(r0, r1):
@@ -353,7 +353,7 @@ def _flush(mode, s, r0, r1, width, axis, origin, spacing, radius, cumulative, z_
             touched[r - r0, c] = False
             value = sheet[r - r0, c] / length
             sheet[r - r0, c] = 0.0
-            if lighting:
+            if lighting is not None:
                 gx = gsheet[0, r - r0, c] / length
                 gy = gsheet[1, r - r0, c] / length
                 gz = gsheet[2, r - r0, c] / length
@@ -375,7 +375,7 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
           slab_start, slab_width, n_slabs, vstart, vinv, dens_tab, emit_tab,
           per_voxel, voxel_density, voxel_colour, grads, lit, ramp_x, ramp_y, threshold, cull,
           row_first, row_last, near, reach_max, band, order, counter, out, voxels, pixels,
-          planes, gplanes, flags, cuts):
+          perspective, lighting, planes, gplanes, flags, cuts):
     """Splat ``data[z, y, x]`` into ``out`` (premultiplied RGBA), bands of ``band`` rows: a
     call takes the next band of ``order`` from the shared queue ``counter``
     (:func:`vrlib._kernels.queue.take`) until none is left, and several threads make the
@@ -413,6 +413,11 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
     beside an eye close to a face). ``reach_max`` bounds the footprint's reach in pixels over the
     volume. ``voxels`` and ``pixels`` count, per band, the footprints drawn and the footprint
     pixels drawn.
+
+    ``perspective`` and ``lighting`` are True for a perspective camera and for gradient
+    sheets (the sheet modes with ``lit``), else None: numba drops the branches a None
+    leaves out before it types the kernel, so that an orthographic or unlit render compiles
+    none of their code (a first render's wait).
     """
     # Views without reference counts for the calls per voxel and per pixel (the caller
     # keeps the arrays).
@@ -442,7 +447,6 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
     qa = 1 if axis == 2 else 2
     ns_, np_, nq = counts[axis], counts[pa], counts[qa]
     px = camera[PIXEL]
-    perspective = is_perspective(camera)
     fwd = (camera[FORWARD], camera[FORWARD + 1], camera[FORWARD + 2])
     lo_box = (origin[0], origin[1], origin[2])
     hi_box = (origin[0] + (nx - 1) * spacing[0], origin[1] + (ny - 1) * spacing[1],
@@ -454,10 +458,9 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
     dq = spacing[qa] * fwd[qa]
     q_lo = min(dq * -ghost, dq * (nq - 1 + ghost))
     q_hi = max(dq * -ghost, dq * (nq - 1 + ghost))
-    reach_depth = 2.0 * extent_s if perspective else extent_s
+    reach_depth = 2.0 * extent_s if perspective is not None else extent_s
     widened = radius + 2.0 * slanted_reach / (slanted.shape[2] - 1)
     passes = n_slabs if mode == IMAGE else slices.shape[0]
-    lighting = mode != DIRECT and (lit[0] != 0.0 or lit[2] != 0.0)
     while True:
         it = take(counter)
         if it >= order.shape[0]:
@@ -466,7 +469,7 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
         r0 = b * band
         r1 = min(r0 + band, height)
         sheet[:] = 0.0
-        if lighting:
+        if lighting is not None:
             gsheet[:] = 0.0
         touched[:] = False
         held_length[:] = 0.0
@@ -536,10 +539,10 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
                         kc = min(max(k, 0), nz - 1)
                         f = data[kc, jc, ic]
                         dens = 0.0
-                        if cull and f == 0.0 and not lighting:
+                        if cull and f == 0.0 and lighting is None:
                             continue  # adds nothing to a sheet, and has no density to draw
                         g0 = g1 = g2 = 0.0
-                        if lighting:
+                        if lighting is not None:
                             g0 = grads[0, kc, jc, ic]
                             g1 = grads[1, kc, jc, ic]
                             g2 = grads[2, kc, jc, ic]
@@ -562,7 +565,7 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
                         row_hi = row_c + extent_v / px
                         col_lo = col_c - extent / px
                         col_hi = col_c + extent / px
-                        if perspective:
+                        if perspective is not None:
                             # (widened by a step of the slanted table, whose interpolation
                             # reaches that far past the support)
                             row_lo, row_hi, col_lo, col_hi = _support_image(
@@ -592,7 +595,7 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
                         elif mode == DIRECT:
                             er, eg, eb = interpolate_rgb(emit_tab, vstart, vinv, f)
                         for r in range(top, bottom + 1):
-                            if perspective or clipped:
+                            if perspective is not None or clipped:
                                 for c in range(left, right + 1):
                                     if opaque[r - r0, c]:
                                         continue
@@ -601,7 +604,7 @@ def splat(data, origin, spacing, camera, height, width, axis, slices, ghost, rad
                                     if mode == IMAGE:
                                         lo = max(lo, z_lo / cosines[r - r0, c])
                                         hi = min(hi, z_hi / cosines[r - r0, c])
-                                    if perspective:
+                                    if perspective is not None:
                                         o, d = pixel_ray(camera, height, width, r, c)
                                         if fkind != RADIAL:
                                             fp = _slanted(slanted, slanted_reach, slanted_slope,
