@@ -28,10 +28,12 @@ import functools
 import math
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 
 from vrlib import validate
 from vrlib._kernels import footprint as _kernel
+from vrlib._scheduling import on_threads
 from vrlib.filters import Gaussian, make_filter
 
 __all__ = ["Footprint", "footprint", "Slanted", "slanted", "running_integral", "RADIAL",
@@ -194,9 +196,12 @@ def _planar(filt, spacing, basis, resolution):
 
     def build(entries, stretches):
         table = np.empty((entries, entries, stretches + 1))
-        _kernel.partial_table(*filt.code, float(filt.radius), h,
-                              np.ascontiguousarray(basis).ravel(), extent_u, extent_v, extent_s,
-                              nodes, weights, table)
+        arguments = (*filt.code, float(filt.radius), h, np.ascontiguousarray(basis).ravel(),
+                     extent_u, extent_v, extent_s, nodes, weights, table, np.zeros(1, np.int64))
+        threads = numba.get_num_threads()
+        # Each thread's scratch for a line's cuts (a cache line apart from the next one's).
+        cuts = np.zeros((threads, 12 * math.ceil(filt.radius) + 11))
+        on_threads(lambda i: _kernel.partial_table(*arguments, cuts[i]), threads)
         return table
 
     # The partial table (clipped footprints) stops at 129 x 129 x 65 (8.6 MB); a finer whole
@@ -274,7 +279,12 @@ def _slanted(filt, slope):
     nm = min(2 * math.ceil(slope / SLANTED_SLOPE_STEP) + 1, 17)
     table = np.empty((nm, nm, nb, nb), np.float32)
     nodes, weights = np.polynomial.legendre.leggauss(5)  # exact for cubic x cubic x cubic
-    _kernel.slanted_table(*filt.code, float(filt.radius), reach, slope, nodes, weights, table)
+    arguments = (*filt.code, float(filt.radius), reach, slope, nodes, weights, table,
+                 np.zeros(1, np.int64))
+    threads = numba.get_num_threads()
+    # Each thread's scratch for a line's cuts (a cache line apart from the next one's).
+    cuts = np.zeros((threads, 12 * math.ceil(filt.radius) + 13))
+    on_threads(lambda i: _kernel.slanted_table(*arguments, cuts[i]), threads)
     return Slanted(table, reach, slope)
 
 

@@ -218,7 +218,8 @@ def row_extents(volume, axis, marks):
     shape = _slice_order(marks, axis).shape[:2]
     first = np.empty(shape, np.int64)
     last = np.empty(shape, np.int64)
-    _kernel.row_extents(readonly(np.asarray(marks)), axis, first, last)
+    arguments = (readonly(np.asarray(marks)), axis, first, last, np.zeros(1, np.int64))
+    on_threads(lambda i: _kernel.row_extents(*arguments), numba.get_num_threads())
     return first, last
 
 

@@ -7,10 +7,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import prange
 
-from vrlib._kernels._jit import at, jit, parallel_jit
+from vrlib._kernels._jit import at, jit
 from vrlib._kernels.filters import weight
+from vrlib._kernels.queue import take
 
 RADIAL, PLANAR = 0, 1
 
@@ -70,9 +70,9 @@ def sort_prefix(values, count):
         values[m + 1] = item
 
 
-@parallel_jit
+@jit
 def partial_table(kind, p0, p1, p2, radius, spacing, basis, extent_u, extent_v, extent_s,
-                  nodes, weights, table):
+                  nodes, weights, table, counter, cuts):
     """Partial line integrals of the separable kernel ``K(p) = prod_a k(p_a / h_a)``:
     ``table[j, i, m] = int_{-extent_s}^{s_m} K(u_i right + v_j up + t forward) dt`` on the grid
     ``u_i`` over ``[-extent_u, extent_u]``, ``v_j`` over ``[-extent_v, extent_v]`` and ``s_m``
@@ -81,15 +81,22 @@ def partial_table(kind, p0, p1, p2, radius, spacing, basis, extent_u, extent_v, 
     Each stretch between grid points is cut where the line crosses a knot of ``k`` (the integers
     and half-integers within its ``radius``) and integrated by Gauss-Legendre
     ``nodes``/``weights`` on ``[-1, 1]`` (exact for the piecewise-polynomial kernels).
+
+    A call takes the next row ``j`` from the shared queue ``counter``
+    (:func:`vrlib._kernels.queue.take`) until none is left, several threads at once
+    (:func:`vrlib._scheduling.on_threads`: a serial kernel compiles in a fraction of a
+    ``prange``'s time); ``cuts`` (``12 ceil(radius) + 3`` floats) is the call's own scratch.
     """
     nv, nu, ns = table.shape
     reach = int(math.ceil(radius))
     n_knots = 4 * reach + 1
     fwd = (basis[6], basis[7], basis[8])
     ds = 2.0 * extent_s / (ns - 1)
-    for j in prange(nv):
+    while True:
+        j = take(counter)
+        if j >= nv:
+            break
         v = -extent_v + 2.0 * extent_v * j / (nv - 1)
-        cuts = np.empty(3 * n_knots)
         for i in range(nu):
             u = -extent_u + 2.0 * extent_u * i / (nu - 1)
             base = (u * basis[0] + v * basis[3], u * basis[1] + v * basis[4],
@@ -235,19 +242,24 @@ def slanted_integral(kind, p0, p1, p2, radius, bp, bq, mp, mq, nodes, weights, s
     return total
 
 
-@parallel_jit
-def slanted_table(kind, p0, p1, p2, radius, reach, slope, nodes, weights, table):
+@jit
+def slanted_table(kind, p0, p1, p2, radius, reach, slope, nodes, weights, table, counter,
+                  cuts):
     """:func:`slanted_integral` on a grid: ``table[a, b, i, j]`` at slopes ``(mp, mq)`` over
     ``[-slope, slope]`` (indices ``a``, ``b``) and offsets ``(bp, bq)`` over
-    ``[-reach, reach]`` (``i``, ``j``)."""
+    ``[-reach, reach]`` (``i``, ``j``). A call takes the next pair of slopes from the shared
+    queue ``counter`` until none is left, several threads at once, as
+    :func:`partial_table`; ``cuts`` (``12 ceil(radius) + 5`` floats) is its own scratch."""
     nm = table.shape[0]
     nb = table.shape[2]
-    for ab in prange(nm * nm):
+    while True:
+        ab = take(counter)
+        if ab >= nm * nm:
+            break
         a = ab // nm
         b = ab % nm
         mp = -slope + 2.0 * slope * a / (nm - 1)
         mq = -slope + 2.0 * slope * b / (nm - 1)
-        cuts = np.empty(12 * int(math.ceil(radius)) + 5)
         for i in range(nb):
             bp = -reach + 2.0 * reach * i / (nb - 1)
             for j in range(nb):

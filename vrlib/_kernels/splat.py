@@ -23,10 +23,7 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-from numba import prange
-
-from vrlib._kernels._jit import borrowed, helper_jit, jit, parallel_jit
+from vrlib._kernels._jit import borrowed, helper_jit, jit
 from vrlib._kernels.camera import (
     FORWARD,
     PIXEL,
@@ -94,17 +91,21 @@ def _q_range(camera, height, x0, y0, z0, dx, dy, dz, nq, row_lo, row_hi):
     return max(0, int(math.floor(lo)) - 1), min(nq - 1, int(math.ceil(hi)) + 1)
 
 
-@parallel_jit
-def row_extents(marks, axis, first, last):
+@jit
+def row_extents(marks, axis, first, last, counter):
     """For each row ``(s, p)`` of the slicing order along ``axis``, the first and last ``q``
-    with a nonzero entry in ``marks[z, y, x]`` (``first = nq``, ``last = -1`` when none)."""
+    with a nonzero entry in ``marks[z, y, x]`` (``first = nq``, ``last = -1`` when none).
+    A call takes the next slice from the shared queue ``counter`` until none is left,
+    several threads at once (:func:`vrlib._scheduling.on_threads`)."""
     nz, ny, nx = marks.shape
     counts = (nx, ny, nz)
     pa = 1 if axis == 0 else 0
     qa = 1 if axis == 2 else 2
     nq = counts[qa]
-    for slice_index in prange(counts[axis]):
-        s = np.int64(slice_index)  # prange counts unsigned; keep the index arithmetic signed
+    while True:
+        s = take(counter)
+        if s >= counts[axis]:
+            break
         for p in range(counts[pa]):
             lo = nq
             hi = -1
@@ -306,8 +307,9 @@ def _flush(mode, s, r0, r1, width, axis, origin, spacing, radius, cumulative, z_
     length (the slice near where the ray enters or leaves) is held for the next slice, and
     what is held at the end is composited after the last one (over its own share, which may
     be negative for kernels with negative lobes). With ``lighting`` (True; None compiles the
-    gradients away) the segment is classified by its mean gradient too (the gradient sheets ``gsheet`` over its length),
-    seen along the pixel's ray (``camera``, an image ``height`` rows high).
+    gradients away) the segment is classified by its mean gradient too (the gradient sheets
+    ``gsheet`` over its length), seen along the pixel's ray (``camera``, an image ``height``
+    rows high).
     """
     for r in range(r0, r1):
         for c in range(width):
