@@ -337,7 +337,8 @@ class RayPlan(NamedTuple):
     order: np.ndarray
     tiles: int
     threads: int
-    #: Each thread's scratch for the filter's weights, and its lanes (:func:`_kernel.lanes`).
+    #: Each thread's scratch for the filter's weights, and its lanes
+    #: (:func:`vrlib._kernels.raycast.lanes`).
     scratch: np.ndarray
     lanes: tuple
     #: The kernel compiled for this kind of render (``filtering, lit, skipping, packets``):

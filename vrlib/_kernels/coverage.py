@@ -21,12 +21,12 @@ from vrlib._kernels.camera import project
 def cover(camera, empty, block, last, origin, spacing, marks, mask):
     """Set ``mask[row, col]`` (``height x width``, False on entry) where a ray can meet one
     of the blocks that ``empty`` (z, y, x: one entry per block of ``block`` cells a side)
-    says are not empty (a corner's sample index is clipped to ``last``, the lattice's last
-    index x, y, z; the grid is read here, not listed in NumPy first, which cost a render
-    0.1 ms); the
-    lattice's sample 0 lies at world ``origin`` with ``spacing``. ``marks`` is scratch of
-    the mask's shape, int32 zeros. Returns False, leaving ``mask`` as it is, when a block
-    reaches behind a perspective eye (every pixel may then see it)."""
+    says are not empty; a corner's sample index is clipped to ``last``, the lattice's last
+    index x, y, z, and the lattice's sample 0 lies at world ``origin`` with ``spacing``.
+    ``marks`` is scratch of the mask's shape, int32 zeros. Returns False, leaving ``mask``
+    as it is, when a block reaches behind a perspective eye (every pixel may then see it).
+    The grid is read here rather than listed in NumPy first (``argwhere`` cost a 512^2
+    render 0.1 ms)."""
     height, width = mask.shape
     lo_r, lo_c, hi_r, hi_c = height, width, 0, 0
     ny, nx = empty.shape[1], empty.shape[2]
