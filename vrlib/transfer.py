@@ -487,8 +487,9 @@ _FEW_INTERVALS = 4
 
 def range_maximum(values, first, last):
     """``max(values[first:last])`` for arrays of ``first < last``: from a sparse table, or,
-    for a few intervals (a render's check of its value range), read directly (building the
-    table cost 60 microseconds a render for a table of 4096 entries).
+    for a few intervals (a render's check of its value range), read directly (for one
+    interval of a table of 4096 entries: 3.5 microseconds, where building the sparse table
+    took 26).
 
     Examples
     --------
