@@ -196,12 +196,10 @@ def _planar(filt, spacing, basis, resolution):
 
     def build(entries, stretches):
         table = np.empty((entries, entries, stretches + 1))
-        arguments = (*filt.code, float(filt.radius), h, np.ascontiguousarray(basis).ravel(),
-                     extent_u, extent_v, extent_s, nodes, weights, table, np.zeros(1, np.int64))
-        threads = numba.get_num_threads()
-        # Each thread's scratch for a line's cuts (a cache line apart from the next one's).
-        cuts = np.zeros((threads, 12 * math.ceil(filt.radius) + 11))
-        on_threads(lambda i: _kernel.partial_table(*arguments, cuts[i]), threads)
+        _on_rows(_kernel.partial_table, (*filt.code, float(filt.radius), h,
+                                          np.ascontiguousarray(basis).ravel(), extent_u,
+                                          extent_v, extent_s, nodes, weights, table),
+                 12 * math.ceil(filt.radius) + 3)
         return table
 
     # The partial table (clipped footprints) stops at 129 x 129 x 65 (8.6 MB); a finer whole
@@ -279,13 +277,20 @@ def _slanted(filt, slope):
     nm = min(2 * math.ceil(slope / SLANTED_SLOPE_STEP) + 1, 17)
     table = np.empty((nm, nm, nb, nb), np.float32)
     nodes, weights = np.polynomial.legendre.leggauss(5)  # exact for cubic x cubic x cubic
-    arguments = (*filt.code, float(filt.radius), reach, slope, nodes, weights, table,
-                 np.zeros(1, np.int64))
-    threads = numba.get_num_threads()
-    # Each thread's scratch for a line's cuts (a cache line apart from the next one's).
-    cuts = np.zeros((threads, 12 * math.ceil(filt.radius) + 13))
-    on_threads(lambda i: _kernel.slanted_table(*arguments, cuts[i]), threads)
+    _on_rows(_kernel.slanted_table,
+             (*filt.code, float(filt.radius), reach, slope, nodes, weights, table),
+             12 * math.ceil(filt.radius) + 5)
     return Slanted(table, reach, slope)
+
+
+def _on_rows(kernel, arguments, cuts):
+    """Fill a table with ``kernel(*arguments, counter, scratch)`` on every thread at once,
+    each taking the table's next row from the shared ``counter``, with scratch of its own
+    for ``cuts`` floats (a line's cuts; a cache line apart from the next thread's)."""
+    threads = numba.get_num_threads()
+    counter = np.zeros(1, np.int64)
+    scratch = np.zeros((threads, cuts + 8))
+    on_threads(lambda i: kernel(*arguments, counter, scratch[i]), threads)
 
 
 def slanted(filt, slope):
