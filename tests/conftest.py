@@ -46,6 +46,23 @@ def pytest_sessionfinish(session):
         warm.wait(timeout=30)
 
 
+@pytest.fixture(autouse=True, scope="session")
+def no_cost_model(tmp_path_factory):
+    """The tests' cost model file (``VRLIB_COST_MODEL``): none, unless a test writes one
+    there or points the variable elsewhere. The user's own, fitted by ``vrlib bench``, would
+    make ``method="auto"`` choose by this machine's timings, and ``vrlib bench`` in a test
+    would overwrite it."""
+    path = tmp_path_factory.mktemp("cost") / "cost.json"
+    held = os.environ.get("VRLIB_COST_MODEL")
+    os.environ["VRLIB_COST_MODEL"] = str(path)
+    yield path
+    path.unlink(missing_ok=True)
+    if held is None:
+        os.environ.pop("VRLIB_COST_MODEL", None)
+    else:
+        os.environ["VRLIB_COST_MODEL"] = held
+
+
 @pytest.fixture(scope="session")
 def mpi_kernels_compiled():
     """The renderers' kernels compiled once, by one rank, before any test starts many: eight

@@ -161,6 +161,8 @@ def test_render_reads_files(tmp_path):
     (["render", "gaussian-blob:8", "--tolerance", "1e-3", "--method", "splat", "-o",
       "x.png"], "use --method raycast or --method auto"),
     (["render", "gaussian-blob:8", "--tolerance", "2", "-o", "x.png"], "tolerance"),
+    (["bench", "--model", "cost.txt"], ".json"),
+    (["bench", "--size", "2"], "--size must be at least 4"),
 ])
 def test_bad_input_exits_2_with_one_line(tmp_path, monkeypatch, capsys, args, message):
     """In process (the installed script is run in the tests around this one): the same
@@ -178,6 +180,24 @@ def test_bad_input_exits_2_with_one_line(tmp_path, monkeypatch, capsys, args, me
     lines = stderr.strip().splitlines()
     assert len(lines) == 1 and message in lines[0], stderr
     assert not any(tmp_path.iterdir()), "nothing may be written on bad input"
+
+
+def test_a_corrupt_cost_model_exits_2_naming_it(tmp_path, monkeypatch, capsys):
+    """--method auto --tolerance reads the cost model: a file that is not one is refused in
+    one line that names it, and the image is not written."""
+    from vrlib import cli
+
+    model = tmp_path / "cost.json"
+    model.write_text("{not json")
+    monkeypatch.setenv("VRLIB_COST_MODEL", str(model))
+    monkeypatch.setattr(cli, "_say_when_compiling", lambda: None)
+    out = tmp_path / "x.png"
+    status = cli.main(["render", "gaussian-blob:8", "--method", "auto", "--tolerance", "1e-2",
+                       "-o", str(out)])
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert status == 2 and len(lines) == 1 and str(model) in lines[0] and "vrlib bench" in \
+        lines[0], lines
+    assert not out.exists()
 
 
 def test_bad_files_exit_2_with_one_line(tmp_path):
@@ -347,10 +367,20 @@ def test_compare_prints_a_table_and_saves_a_figure(tmp_path):
     assert out.read_bytes().startswith(b"\x89PNG")
 
 
-def test_bench_and_info():
-    done = run("bench", "--samples", "12", "--size", "16", "--repeats", "1")
+def test_bench_and_info(tmp_path):
+    """``vrlib bench`` prints every method's time and error, and fits the cost model that
+    ``method="auto"`` reads."""
+    from vrlib.cost import load_model
+
+    path = tmp_path / "cost.json"
+    done = run("bench", "--samples", "12", "--size", "16", "--repeats", "1", "--model",
+               str(path))
     assert done.returncode == 0, done.stderr
     assert "rmse" in done.stdout and done.stdout.count("\n") >= 11
+    assert f"kept in {path}" in done.stdout
+    model = load_model(path)
+    assert sorted(model["methods"]) == sorted(vrlib.METHODS)
+    assert model["methods"]["raycast"]["c_pt"] + model["methods"]["raycast"]["c_op"] > 0
     done = run("info")
     assert done.returncode == 0
     assert "numba" in done.stdout and "MPICH" in done.stdout

@@ -375,11 +375,15 @@ def cmd_render(args):
         if options:
             raise UsageError("--tolerance chooses the method's options itself: leave out "
                              "--option")
+        # --method auto with no --filter: the filter is chosen too (vrlib.auto)
+        filt = (None if method == "auto" and args.filter is None and not args.labels
+                else _filter(args))
         seconds, img = measure(partial(
-            vrlib.render, volume, view, method=method, filter=_filter(args),
+            vrlib.render, volume, view, method=method, filter=filt,
             transfer=transfer, tolerance=args.tolerance), repeats=1, warmup=False)
         chosen = img.stats.choices
-        what = (f"{chosen['method']}/{_filter(args)} to rmse {args.tolerance:g} (step "
+        name = _filter(args) if filt is not None else chosen["auto"]["filter"]
+        what = (f"{chosen['method']}/{name} to rmse {args.tolerance:g} (step "
                 f"{chosen['step']:.3g} voxel, {chosen['classification']}, estimated error "
                 f"{chosen['estimate']:.2g})")
     else:
@@ -489,24 +493,48 @@ def cmd_bench(args):
 
     import data_gen
     import vrlib
-    from vrlib.cost import measure
+    from vrlib.cost import fit_methods, measure, points, save_model
 
+    if args.model is not None:
+        check_output(args.model, (".json",))
+    for name in ("samples", "size", "repeats"):
+        if getattr(args, name) < (4 if name != "repeats" else 1):
+            raise UsageError(f"--{name} must be at least {4 if name != 'repeats' else 1}, "
+                             f"got {getattr(args, name)}")
     field = data_gen.make_field("marschner-lobb")
     volume = field.sample(args.samples)
-    view = vrlib.View.orbit(azimuth=30, elevation=20, size=args.size)
     transfer = vrlib.Glow(1.0)
-    reference = vrlib.render_reference(field, view, transfer=transfer)
-    runs = [(m, f) for m in vrlib.METHODS for f in ("trilinear", "catmull-rom")]
-    rows = []
-    for method, filt in tqdm(runs, desc="bench", file=sys.stderr, disable=None):
-        best, img = measure(partial(vrlib.render, volume, view, method=method, filter=filt,
-                                    transfer=transfer), repeats=args.repeats)
-        rows.append((method, filt, best, vrlib.metrics.rmse(img, reference)))
+    # The table's frames (every method and two filters at --size), and for the cost model
+    # the same at half the size, and ray casting also at a step of 2 voxels: frames whose
+    # points and operations differ, so that the constants separate.
+    views = {size: vrlib.View.orbit(azimuth=30, elevation=20, size=size)
+             for size in (max(4, args.size // 2), args.size)}
+    reference = vrlib.render_reference(field, views[args.size], transfer=transfer)
+    runs = [(m, f, size, step) for m in vrlib.METHODS for f in ("trilinear", "catmull-rom")
+            for size in views for step in ((0.5, 2.0) if m == "raycast" else (0.5,))]
+    rows, frames = [], []
+    for method, filt, size, step in tqdm(runs, desc="bench", file=sys.stderr, disable=None):
+        best, img = measure(partial(vrlib.render, volume, views[size], method=method,
+                                    filter=filt, transfer=transfer, step=step),
+                            repeats=args.repeats)
+        frames.append({"method": method, "operations": img.stats.operations,
+                       "points": points(img.stats), "seconds": best})
+        if size == args.size and step == 0.5:
+            rows.append((method, filt, best, vrlib.metrics.rmse(img, reference)))
     print(f"Marschner-Lobb {args.samples}^3 -> {args.size}^2, best of {args.repeats}, "
           f"rmse against the reference renderer")
     print(f"{'method':<10} {'filter':<12} {'seconds':>8} {'rmse':>10}")
     for method, filt, seconds, rmse in sorted(rows, key=lambda r: r[2]):
         print(f"{method:<10} {filt:<12} {seconds:8.4f} {rmse:10.2e}")
+    fitted = fit_methods(frames)
+    path = save_model(fitted, args.model)
+    print(f"\ncost model t = c_op operations + c_pt points + c_0, fitted per method to "
+          f"{len(frames)} frames, kept in {path}\n(render(..., method='auto', tolerance=t) "
+          f"reads it to choose the filter)")
+    print(f"{'method':<10} {'c_op ns':>8} {'c_pt ns':>8} {'c_0 ms':>8} {'median error':>13}")
+    for method, c in fitted.items():
+        print(f"{method:<10} {c['c_op'] * 1e9:8.3f} {c['c_pt'] * 1e9:8.2f} "
+              f"{c['c_0'] * 1e3:8.3f} {c['median_error']:12.0%}")
 
 
 def _type_name(dtype):
@@ -688,6 +716,9 @@ def parser():
     bench.add_argument("--samples", type=int, default=64)
     bench.add_argument("--size", type=int, default=128)
     bench.add_argument("--repeats", type=int, default=3)
+    bench.add_argument("--model", help="where to keep the cost model fitted to the frames, "
+                                       "a .json file (default $VRLIB_COST_MODEL, else "
+                                       "~/.cache/vrlib/cost-<machine>.json)")
     bench.set_defaults(run=cmd_bench)
     info = sub.add_parser("info", help="a volume's shape, spacing and values (to choose a "
                                        "transfer function); without one, the machine, "

@@ -8,6 +8,7 @@ import inspect
 from vrlib import validate
 from vrlib._scheduling import thread_count
 from vrlib.arguments import framed_view, refuse_gradients, render_arguments
+from vrlib.auto import render_auto
 from vrlib.colormapping import auto_transfer, default_transfer
 from vrlib.holes import with_holes
 from vrlib.projection import BLENDS, render_projection
@@ -58,8 +59,8 @@ def method_options(method):
 
 def chosen_method(method):
     """The method :func:`render` runs for ``method``: ``"auto"`` is ray casting, the one
-    method that renders to a tolerance (a choice between methods by the cost model is not
-    built).
+    method that renders to a tolerance (where one is given without a filter, the filter is
+    chosen by this machine's cost model: :mod:`vrlib.auto`).
 
     Examples
     --------
@@ -77,7 +78,7 @@ def _own_options(method):
             if p.kind is p.KEYWORD_ONLY and p.name not in _COMMON}
 
 
-def render(volume, view, *, method="raycast", filter="trilinear", transfer=None, step=None,
+def render(volume, view, *, method="raycast", filter=None, transfer=None, step=None,
            early_termination=None, empty_space_skipping=True, blend="emission-absorption",
            threads=None, tolerance=None, **options):
     """Render a volume into an image.
@@ -87,8 +88,10 @@ def render(volume, view, *, method="raycast", filter="trilinear", transfer=None,
     volume : Volume
     view : View
     method : {"raycast", "splat", "shear3", "shear2", "shearwarp", "auto"}
-        The rendering method (see :data:`METHODS`). ``"auto"`` picks one for you: ray
-        casting, the one method that renders to a tolerance, for now.
+        The rendering method (see :data:`METHODS`). ``"auto"`` is ray casting, the one
+        method that renders to a tolerance; with a ``tolerance`` and no ``filter``, it also
+        chooses the filter that this machine's cost model predicts reaches the tolerance
+        soonest (:mod:`vrlib.auto`; ``vrlib bench`` fits the model).
     filter : str, tuple or Filter, default "trilinear"
         Reconstruction filter, by name or built with :func:`vrlib.make_filter`. Trilinear is
         the default here and on the command line because it is the fastest; ``"catmull-rom"``
@@ -162,13 +165,15 @@ def render(volume, view, *, method="raycast", filter="trilinear", transfer=None,
         transfer = auto_transfer(volume)
     if tolerance is not None:
         _check_tolerance_arguments(method, step, early_termination, blend, options)
+    choose_filter = method == "auto" and tolerance is not None and filter is None
+    filter = "trilinear" if filter is None else filter
     method = chosen_method(method)
     step = 0.5 if step is None else step
     early_termination = 0.999 if early_termination is None else early_termination
     filt, transfer, step, early_termination = render_arguments(view, filter, transfer, step,
                                                                early_termination)
     view = framed_view(view, volume.extent, transfer, volume.value_range)
-    transfer = with_holes(volume, transfer, filt, method)
+    unwrapped, transfer = transfer, with_holes(volume, transfer, filt, method)
     if not isinstance(empty_space_skipping, bool):
         raise TypeError(
             f"empty_space_skipping must be True or False, got {empty_space_skipping!r}"
@@ -189,6 +194,10 @@ def render(volume, view, *, method="raycast", filter="trilinear", transfer=None,
                                          blend=blend)
             return render_projection(volume, view, filt=filt, transfer=transfer, step=step,
                                      blend=blend)
+    if choose_filter:
+        with thread_count(threads):
+            return render_auto(volume, view, transfer=unwrapped, tolerance=tolerance,
+                               empty_space_skipping=empty_space_skipping)
     if tolerance is not None:
         with thread_count(threads):
             return render_within(volume, view, filt=filt, transfer=transfer,
