@@ -69,7 +69,7 @@ def framed_view(view, extent, transfer=None, value_range=None):
             "frames the volume) or View.fit(volume, ...)", EmptyImageWarning, stacklevel=3)
     elif transfer is not None and value_range is not None:
         low, high = value_range
-        if float(transfer.max_density(low, high)) == 0.0:
+        if transfer.densest(low, high) == 0.0:
             warnings.warn(
                 f"the transfer function {transfer!r} is transparent over all the volume's "
                 f"values [{low:g}, {high:g}]: the image is empty; choose opacity over that "

@@ -361,6 +361,19 @@ class TransferFunction:
         inverse_step = (values.size - 1) / (stop - start)
         return start, inverse_step, self.opacity_density(values), self.emission(values)
 
+    def densest(self, low, high):
+        """:meth:`max_density` over ``[low, high]`` as a float, kept as the tables are (a
+        render asks it of its volume's value range, to warn of an empty image: 20 to 130
+        microseconds for a lookup table).
+
+        Examples
+        --------
+        >>> LookupTransfer([0.0, 2.0, 0.0]).densest(0.0, 0.25)
+        1.0
+        """
+        return self._kept(("densest", float(low), float(high)),
+                          lambda: float(self.max_density(low, high)))
+
     def brightest_emission(self, low, high):
         """The largest value of any channel of the emission on :meth:`value_table`'s grid
         for ``[low, high]`` (which covers that interval, so that this bounds the emission
