@@ -384,3 +384,4 @@ def test_bench_and_info(tmp_path):
     done = run("info")
     assert done.returncode == 0
     assert "numba" in done.stdout and "MPICH" in done.stdout
+    assert "cost model: none at" in done.stdout  # the tests' own file, not written yet

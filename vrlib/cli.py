@@ -616,6 +616,15 @@ def cmd_info(args):
     lines.append(f"mpiexec: {mpiexec if mpiexec.exists() else 'not found beside python'}")
     lines.append(f"methods: {', '.join(vrlib.METHODS)}")
     lines.append(f"filters: {', '.join(vrlib.FILTERS)}")
+    from vrlib.cost import load_model, model_path
+
+    try:
+        model = load_model()
+        kept = (f"{model['path']} ({', '.join(model['methods'])})" if model else
+                f"none at {model_path()} (vrlib bench fits it; method='auto' reads it)")
+    except ValueError as error:
+        kept = str(error)
+    lines.append(f"cost model: {kept}")
     print("\n".join(lines))
 
 
