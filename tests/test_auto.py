@@ -128,3 +128,16 @@ def test_a_nan_constant_is_refused(tmp_path):
                     '{"c_op": NaN, "c_pt": 0, "c_0": 0}}}')
     with pytest.raises(ValueError, match="raycast c_op is nan, not a finite number"):
         load_model(path)
+
+
+def test_a_model_fitted_again_is_read_again(tmp_path):
+    """The model is read once per version of its file; ``vrlib bench`` writing it again (a
+    new file renamed onto the old) is seen at the next read."""
+    path = tmp_path / "cost.json"
+    save_model({"raycast": {"c_op": 1e-10, "c_pt": 1e-8, "c_0": 1e-3}}, path)
+    assert load_model(path)["methods"]["raycast"]["c_0"] == 1e-3
+    assert load_model(path) is load_model(path)
+    save_model({"raycast": {"c_op": 1e-10, "c_pt": 1e-8, "c_0": 2e-3}}, path)
+    assert load_model(path)["methods"]["raycast"]["c_0"] == 2e-3
+    path.unlink()
+    assert load_model(path) is None

@@ -162,7 +162,7 @@ def test_render_reads_files(tmp_path):
       "x.png"], "use --method raycast or --method auto"),
     (["render", "gaussian-blob:8", "--tolerance", "2", "-o", "x.png"], "tolerance"),
     (["bench", "--model", "cost.txt"], ".json"),
-    (["bench", "--size", "2"], "--size must be at least 4"),
+    (["bench", "--size", "7"], "--size must be at least 8, got 7"),
 ])
 def test_bad_input_exits_2_with_one_line(tmp_path, monkeypatch, capsys, args, message):
     """In process (the installed script is run in the tests around this one): the same

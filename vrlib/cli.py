@@ -497,10 +497,10 @@ def cmd_bench(args):
 
     if args.model is not None:
         check_output(args.model, (".json",))
-    for name in ("samples", "size", "repeats"):
-        if getattr(args, name) < (4 if name != "repeats" else 1):
-            raise UsageError(f"--{name} must be at least {4 if name != 'repeats' else 1}, "
-                             f"got {getattr(args, name)}")
+    # two image sizes (--size and half of it) for each method's three frames or more
+    for name, least in (("samples", 4), ("size", 8), ("repeats", 1)):
+        if getattr(args, name) < least:
+            raise UsageError(f"--{name} must be at least {least}, got {getattr(args, name)}")
     field = data_gen.make_field("marschner-lobb")
     volume = field.sample(args.samples)
     transfer = vrlib.Glow(1.0)

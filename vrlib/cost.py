@@ -40,6 +40,8 @@ MODEL_FORMAT = "vrlib cost model 1"
 #: A cost model file is a few hundred bytes; a larger one is not read.
 _MODEL_MAX_BYTES = 1 << 16
 _CONSTANTS = ("c_op", "c_pt", "c_0")
+#: Models read, by path: (the file's device, inode, size and time, the model).
+_LOADED = {}
 
 
 def machine():
@@ -264,8 +266,9 @@ def load_model(path=None):
     Returns
     -------
     dict or None
-        ``machine`` (the record of the machine it was fitted on) and ``methods``: per method,
-        the constants ``c_op``, ``c_pt`` and ``c_0``.
+        ``machine`` (the record of the machine it was fitted on), ``methods`` (per method, the
+        constants ``c_op``, ``c_pt`` and ``c_0``) and ``path``; read once per version of the
+        file (its size and time) and shared between calls: not to be changed.
 
     Raises
     ------
@@ -285,6 +288,11 @@ def load_model(path=None):
     """
     path = model_path() if path is None else Path(path)
     try:
+        stat = os.stat(path)
+        version = (stat.st_dev, stat.st_ino, stat.st_size, stat.st_mtime_ns)
+        held = _LOADED.get(str(path))
+        if held is not None and held[0] == version:
+            return held[1]  # read once per version of the file
         with open(path, "rb") as file:
             raw = file.read(_MODEL_MAX_BYTES + 1)
     except FileNotFoundError:
@@ -318,5 +326,7 @@ def load_model(path=None):
                 raise refuse(f"{method} {name} is {value!r}, not a finite number >= 0")
         model[str(method)] = {name: float(value) for name, value in values.items()}
     machine_record = record.get("machine")
-    return {"machine": machine_record if isinstance(machine_record, dict) else {},
-            "methods": model, "path": str(path)}
+    loaded = {"machine": machine_record if isinstance(machine_record, dict) else {},
+              "methods": model, "path": str(path)}
+    _LOADED[str(path)] = (version, loaded)
+    return loaded

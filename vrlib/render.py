@@ -92,8 +92,9 @@ def render(volume, view, *, method="raycast", filter=None, transfer=None, step=N
         method that renders to a tolerance; with a ``tolerance`` and no ``filter``, it also
         chooses the filter that this machine's cost model predicts reaches the tolerance
         soonest (:mod:`vrlib.auto`; ``vrlib bench`` fits the model).
-    filter : str, tuple or Filter, default "trilinear"
-        Reconstruction filter, by name or built with :func:`vrlib.make_filter`. Trilinear is
+    filter : str, tuple or Filter, optional
+        Reconstruction filter, by name or built with :func:`vrlib.make_filter`; left out,
+        trilinear (or, with ``method="auto"`` and a ``tolerance``, the one chosen). Trilinear is
         the default here and on the command line because it is the fastest; ``"catmull-rom"``
         is more accurate (the report's chapter 3) and slower (chapter 4 times both). A prefiltered
         filter (``"cardinal-bspline"``, ``"omoms"``) reconstructs spline coefficients with its
