@@ -16,10 +16,10 @@ import tempfile
 from functools import partial
 from pathlib import Path
 
+import bench_raycast_vtk
 import numpy as np
 from _report import best_of_each, markdown, write_record
 
-import data_gen
 import vrlib
 from vrlib import cli
 
@@ -31,18 +31,10 @@ FILTERS = ("trilinear", "catmull-rom")
 
 
 def scenes():
-    """``{label: (volume, transfer)}``: dense, sparse and smooth, as the other benchmarks."""
-    ramp = np.linspace(0.0, 1.0, 11)
-    sparse = vrlib.LookupTransfer(6.0 * np.clip((ramp - 0.1) / 0.9, 0.0, None),
-                                  value_range=(0.0, 1.0))
-    blobs = data_gen.make_field("random-blobs", count=6, seed=4, sigma=(0.06, 0.1))
-    return {
-        "dense (Marschner-Lobb, Glow)": (data_gen.make_field("marschner-lobb").sample(
-            N, dtype=np.float32), vrlib.Glow(1.0)),
-        "sparse (6 blobs, ramp from 0.1)": (blobs.sample(N, dtype=np.float32), sparse),
-        "long tails (blob sigma 0.35, Glow 2)": (data_gen.make_field(
-            "gaussian-blob", sigma=0.35).sample(N, dtype=np.float32), vrlib.Glow(2.0)),
-    }
+    """``{label: (volume, transfer)}``: the ray-casting benchmark's dense, sparse and smooth
+    scenes (:func:`bench_raycast_vtk.scenes`), sampled at :data:`N`."""
+    return {label: (field.sample(N, dtype=np.float32), transfer)
+            for label, (field, transfer) in bench_raycast_vtk.scenes().items()}
 
 
 def main():
