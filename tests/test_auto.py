@@ -141,3 +141,13 @@ def test_a_model_fitted_again_is_read_again(tmp_path):
     assert load_model(path)["methods"]["raycast"]["c_0"] == 2e-3
     path.unlink()
     assert load_model(path) is None
+
+
+def test_a_model_without_ray_casting_chooses_nothing_and_says_so(scene, tmp_path,
+                                                                 monkeypatch):
+    vol, view = scene
+    path = save_model({"splat": {"c_op": 1e-9, "c_pt": 0.0, "c_0": 0.0}}, tmp_path / "c.json")
+    monkeypatch.setenv("VRLIB_COST_MODEL", str(path))
+    img = render(vol, view, method="auto", tolerance=TOLERANCE)
+    assert img.stats.choices["auto"]["filter"] == "trilinear"
+    assert "no ray casting" in candidates(img)["catmull-rom"]["skipped"]
