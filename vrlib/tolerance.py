@@ -32,6 +32,11 @@ How it is kept (docs/kernel.md):
   one's error), the model does not hold up to that step, and only a pilot's own step is
   taken there: the coarser one if the difference plus the finer one's error meets the
   share, else the finer, unless a pilot at the step itself bore it out (below).
+* On an orthographic view the sampling's phase is checked at the step chosen: the same view
+  moved half a step back along its direction samples the lattice at the other phase, and
+  the step is halved while the estimate plus what that changes exceeds the share (views along
+  the lattice, where every ray samples it at the same phase, had let the pilots agree while
+  all missed a narrow peak: up to 14 times the tolerance).
 * On a large image (:data:`LONGER_PIXELS` times the pilot's pixels) whose step reached the
   pilot's first, longer steps are tried up to :data:`LONGEST_STEP`: each doubling is one more
   pilot, and is taken while the error at the last step plus the difference between the two
@@ -204,7 +209,7 @@ def plan_within(volume, view, *, filt, transfer, tolerance, empty_space_skipping
     if abandon is not None and abandon(longest):
         return None
     target = STEP_SHARE * tolerance
-    steps, differences, alignments = [], [], []
+    steps, differences, alignments, images = [], [], [], {}
     step = MAX_STEP
     previous = change = predicted = coarsest = pilot_samples = None
     while True:
@@ -212,7 +217,7 @@ def plan_within(volume, view, *, filt, transfer, tolerance, empty_space_skipping
         pilot = render_raycast(volume, pilot_view, step=step, **options)
         if coarsest is None:
             coarsest, pilot_samples = pilot.rgba, pilot.stats.points
-        pilot = pilot.rgba
+        pilot = images[step] = pilot.rgba
         if previous is not None:
             last_change, change = change, previous - pilot
             differences.append(_rms(change))
@@ -276,6 +281,11 @@ def plan_within(volume, view, *, filt, transfer, tolerance, empty_space_skipping
             if error + longer[-1] > target:
                 break
             error, last, step = error + longer[-1], doubled, 2.0 * step
+            images[step] = doubled
+    phase = []
+    if not view.is_perspective:
+        step, error, phase = _phase_checked(volume, pilot_view, step, error, error_at, target,
+                                            options, images, tolerance, filt)
     pilot_seconds = time.perf_counter() - start
     choices = {
         "tolerance": tolerance, "method": "raycast", "filter": filt.name, "step": step,
@@ -284,7 +294,8 @@ def plan_within(volume, view, *, filt, transfer, tolerance, empty_space_skipping
         "estimate": error + TERM_SHARE * tolerance,
         "pilot": {"shape": list(pilot_view.shape), "steps": steps,
                   "differences": differences, "alignments": alignments,
-                  "checked": checked, "longer": longer, "seconds": pilot_seconds},
+                  "checked": checked, "longer": longer, "phase": phase,
+                  "seconds": pilot_seconds},
     }
     return Plan(step=step, error=error, options=options, choices=choices,
                 pilot_samples=int(pilot_samples),
@@ -323,6 +334,54 @@ def _within_measured(steps, differences, step, error_at, target):
             upper = difference + error
             return (coarse, upper) if upper <= target else (fine, error)
     return step, error_at(step)
+
+
+def _phase_checked(volume, view, step, error, error_at, target, options, images, tolerance,
+                   filt):
+    """The step, its error and the checks made, once the sampling's phase is checked at
+    ``step`` (orthographic views).
+
+    A ray's samples lie a whole number of steps (and a half) from where it starts. Where the
+    rays run along the lattice (a view along an axis or a diagonal of the volume), every ray
+    samples the lattice at the same phase, and the pilots at steps 2, 1, 1/2 ... can agree
+    while all miss what lies between their samples (a narrow opacity peak seen along z:
+    their differences gave an error 14 times too small). The same image with the camera
+    moved half a step back along its direction (:meth:`vrlib.View.moved_back`) is exactly
+    the same image and samples at the other phase: its rms difference ``d`` from the first is
+    what the phase changes, ``d / sqrt 2`` for each if the two phases' own errors are
+    uncorrelated. The pilots' estimate plus that bounds the image's error; while it exceeds
+    ``target`` the step is halved (each halving two more pilots), down to :data:`MIN_STEP`.
+    Measured on 84 cases (chapter 11's seven analytic scenes at 64^2, views along x, y and
+    z, along a diagonal, oblique and in perspective, 1e-2 and 1e-3): 13 promises broken
+    without the check (up to 14 times), none with it (worst 0.69). Not cheaper: the root of
+    the sum of squares missed a narrow peak seen along x by 1.1 times; trusting the pilots
+    wherever ``d / sqrt 2`` lay within their estimate missed it by 6.5 times. Its price is on
+    views across the lattice, where the pilots had seen the phases already: chapter 11's
+    orthographic cases take steps up to half as long (19 instead of 26 to 32 of its 44 timed
+    cases within 1.5 times the fastest fixed setting), and its shaded field at 1e-4 is
+    refused.
+    """
+    checks = []
+    while True:
+        here = images.get(step)
+        if here is None:
+            here = images[step] = render_raycast(volume, view, step=step, **options).rgba
+        shift = 0.5 * step * float(np.min(volume.spacing))
+        there = render_raycast(volume, view.moved_back(shift), step=step, **options).rgba
+        difference = _rms(here - there)
+        checks.append([step, difference])
+        total = error + difference / math.sqrt(2.0)
+        if total <= target:
+            return step, total, checks
+        if step / 2.0 < MIN_STEP:
+            raise ValueError(
+                f"tolerance={tolerance:g} is out of reach of ray casting with the {filt.name} "
+                f"filter here: at a step of {step:g} voxel the image still changes by "
+                f"{difference:.2g} with the samples' phase; ask for a tolerance of at least "
+                f"{total / STEP_SHARE:.2g}")
+        step /= 2.0
+        if step <= MAX_STEP:
+            error = error_at(step)
 
 
 def _first_order_bound(difference):

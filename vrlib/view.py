@@ -222,6 +222,25 @@ class View:
         view._set_size(size)
         return view
 
+    def moved_back(self, distance):
+        """This view with its camera moved ``distance`` world units back along its direction.
+        An orthographic view's rays stay on their lines, so it sees the same image of
+        everything in front of it, while each ray's samples, spaced from where it starts,
+        move ``distance`` along it (:mod:`vrlib.tolerance` checks the sampling's phase so).
+
+        Examples
+        --------
+        >>> view = View.orbit(azimuth=30, size=8, radius=1.0)
+        >>> back = view.moved_back(0.25)
+        >>> bool(np.allclose(view.start - back.start, 0.25 * view.forward)), back.shape
+        (True, (8, 8))
+        """
+        view = copy.copy(self)
+        view._fitted = view._seen = None
+        view.center = self.center - distance * self.forward
+        view.center.flags.writeable = False
+        return view
+
     def _set_size(self, size):
         """The image's ``size`` and the pixels' pitch that follows from it."""
         self.height, self.width = _image_size(size)
