@@ -17,15 +17,16 @@ def promise_figure():
     labels = {c["scene"]: c["label"] for c in cases}
     fig, (left, right) = plt.subplots(1, 2, figsize=(11, 4.4), layout="tight")
     for i, scene in enumerate(scenes):
-        for view, fill in (("orthographic", True), ("perspective", False)):
+        for view, fill in (("orthographic", "full"), ("along x", "left"),
+                           ("perspective", "none")):
             sel = [c for c in cases if c["scene"] == scene and c["view"] == view]
             if not sel:
                 continue
             jitter = 1.0 + 0.06 * (i - len(scenes) / 2)
             kwargs = dict(marker=MARKERS[i % len(MARKERS)], color=f"C{i}", ls="none", ms=5,
-                          mfc=f"C{i}" if fill else "none")
+                          fillstyle=fill)
             left.loglog([c["tolerance"] * jitter for c in sel], [c["rmse"] for c in sel],
-                        label=labels[scene] if fill else None, **kwargs)
+                        label=labels[scene] if fill == "full" else None, **kwargs)
             right.semilogx([c["tolerance"] * jitter for c in sel],
                            [c["ratio"] if c["ratio"] is not None else np.nan for c in sel],
                            **kwargs)
@@ -34,7 +35,8 @@ def promise_figure():
     left.set_xlabel("tolerance asked (rmse)")
     left.set_ylabel("rmse achieved against the exact image")
     left.set_title(f"Error achieved ({data['summary']['kept']} of "
-                   f"{data['summary']['cases']} kept; hollow: perspective)", fontsize=10)
+                   f"{data['summary']['cases']} kept; half filled: along x; hollow: "
+                   "perspective)", fontsize=10)
     left.legend(fontsize=7, loc="upper left")
     right.axhline(1.5, color="k", lw=1, ls="--")
     right.axhline(1.0, color="k", lw=0.5)
