@@ -103,8 +103,6 @@ class Plan:
     ----------
     step : float
         The step chosen (voxels).
-    error : float
-        The estimated error along rays at that step (early termination's share apart).
     options : dict
         The ray caster's arguments besides the step (filter, transfer function, early
         termination, classification, segment ends, the pilots' memo).
@@ -120,7 +118,6 @@ class Plan:
     """
 
     step: float
-    error: float
     options: dict
     choices: dict
     pilot_samples: int
@@ -297,7 +294,7 @@ def plan_within(volume, view, *, filt, transfer, tolerance, empty_space_skipping
                   "checked": checked, "longer": longer, "phase": phase,
                   "seconds": pilot_seconds},
     }
-    return Plan(step=step, error=error, options=options, choices=choices,
+    return Plan(step=step, options=options, choices=choices,
                 pilot_samples=int(pilot_samples),
                 pilot_pixels=pilot_view.height * pilot_view.width, longest=longest)
 
