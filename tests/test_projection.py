@@ -69,6 +69,7 @@ def test_every_filter_projects_a_constant_exactly(filt):
                                    atol=1e-9)
 
 
+@pytest.mark.slow  # 19 s in make test: make test-all runs it (CI's 5 minutes)
 def test_maximum_bounds_average_on_a_real_volume():
     """The MNI brain: on every ray the maximum is at least the mean, and the images do not
     depend on the thread count."""

@@ -48,6 +48,7 @@ def test_kernel_matches_naive_twin(projection, filt, transfer):
 
 
 
+@pytest.mark.slow  # 24 s in make test: make test-all runs it (CI's 5 minutes)
 def test_box_filter_shades_by_the_sampled_gradient():
     """The box filter's derivative is zero, so shading by it drew the unshaded image,
     silently (the README's ``--labels --shade`` frog). It now takes the samples' gradient at
