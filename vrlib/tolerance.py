@@ -350,13 +350,17 @@ def _phase_checked(volume, view, step, error, error_at, target, options, images,
     ``target`` the step is halved (each halving two more pilots), down to :data:`MIN_STEP`.
     Measured on 84 cases (chapter 11's seven analytic scenes at 64^2, views along x, y and
     z, along a diagonal, oblique and in perspective, 1e-2 and 1e-3): 13 promises broken
-    without the check (up to 14 times), none with it (worst 0.69). Not cheaper: the root of
-    the sum of squares missed a narrow peak seen along x by 1.1 times; trusting the pilots
-    wherever ``d / sqrt 2`` lay within their estimate missed it by 6.5 times. Its price is on
-    views across the lattice, where the pilots had seen the phases already: chapter 11's
-    orthographic cases take steps up to half as long (19 instead of 26 to 32 of its 44 timed
-    cases within 1.5 times the fastest fixed setting), and its shaded field at 1e-4 is
-    refused.
+    without the check (up to 14 times), none with it (worst 0.69). Views near the lattice
+    need it too (the narrow peak 8 degrees off x: 2.98 times without it), so no test of the
+    view's direction replaces it. Not cheaper: the root of the sum of squares missed a
+    narrow peak seen along x by 1.1 times; trusting the pilots wherever ``d / sqrt 2`` lay
+    within their estimate missed it by 6.5 times; jittered rays (a phase per pixel) with the
+    pilots alone, 4.1 times a degree off x; shrinking the step in proportion to the sum
+    instead of halving it took that peak along x to 0.98 of its tolerance (docs/kernel.md).
+    Its price is on views across the lattice, where the pilots had seen the phases already:
+    chapter 11's orthographic cases take steps up to half as long (19 instead of 26 to 32 of
+    its 44 timed cases within 1.5 times the fastest fixed setting), and its shaded field at
+    1e-4 is refused.
     """
     checks = []
     while True:

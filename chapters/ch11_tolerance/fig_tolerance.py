@@ -1,6 +1,8 @@
 """Figures: the promise of ``tolerance=`` (error achieved against error asked, time against
-the fastest fixed setting) and pre-integration against point sampling on steep transfer
-functions."""
+the fastest fixed setting; the error seen along and near the lattice) and pre-integration
+against point sampling on steep transfer functions."""
+
+import textwrap
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -48,6 +50,33 @@ def promise_figure():
     save_figure(fig, figure_path(__file__, "promise.png"))
 
 
+def views_figure():
+    data = read_json(result_path(__file__, "views.json"))
+    cases = [c for c in data["cases"] if "rmse" in c]
+    views = data["view_order"]
+    scenes = list(dict.fromkeys(c["scene"] for c in data["cases"]))
+    labels = {c["scene"]: c["label"] for c in data["cases"]}
+    fig, ax = plt.subplots(figsize=(11, 4.4), layout="tight")
+    for i, scene in enumerate(scenes):
+        for tolerance, fill in zip(data["tolerances"], ("full", "none"), strict=True):
+            sel = [c for c in cases if c["scene"] == scene and c["tolerance"] == tolerance]
+            ax.semilogy([views.index(c["view"]) + 0.08 * (i - len(scenes) / 2) for c in sel],
+                        [c["rmse"] / c["tolerance"] for c in sel],
+                        marker=MARKERS[i % len(MARKERS)], color=f"C{i}", ls="none", ms=5,
+                        fillstyle=fill, label=labels[scene] if fill == "full" else None)
+    ax.axhline(1.0, color="k", lw=1, label="error = tolerance")
+    ax.set_xticks(range(len(views)), [textwrap.fill(v, 10) for v in views], fontsize=8)
+    ax.set_ylabel("rmse achieved / tolerance asked")
+    summary = data["summary"]
+    ax.set_title(f"Views along and near the lattice, {data['size']}^2: {summary['kept']} of "
+                 f"{summary['cases']} kept, {summary['refused']} refused (filled: "
+                 f"{data['tolerances'][0]:g}; hollow: {data['tolerances'][1]:g})",
+                 fontsize=10)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+    ax.grid(True, which="both", alpha=0.3)
+    save_figure(fig, figure_path(__file__, "views.png"))
+
+
 def preintegration_figure():
     data = read_json(result_path(__file__, "preintegration.json"))
     rows = data["rows"]
@@ -86,6 +115,7 @@ def _short(scene):
 
 def main():
     promise_figure()
+    views_figure()
     preintegration_figure()
 
 
