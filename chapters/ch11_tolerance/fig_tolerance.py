@@ -53,7 +53,7 @@ def promise_figure():
 def views_figure():
     data = read_json(result_path(__file__, "views.json"))
     cases = [c for c in data["cases"] if "rmse" in c]
-    views = data["view_order"]
+    views = [name for name, _ in data["views"]]
     scenes = list(dict.fromkeys(c["scene"] for c in data["cases"]))
     labels = {c["scene"]: c["label"] for c in data["cases"]}
     fig, ax = plt.subplots(figsize=(11, 4.4), layout="tight")

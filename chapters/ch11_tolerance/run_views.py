@@ -48,8 +48,8 @@ def main():
     worst = {view: max((c["rmse"] / c["tolerance"] for c in rendered if c["view"] == view),
                        default=None) for view in VIEWS}
     write_json(result_path(__file__, "views.json"), {
-        "cases": cases, "size": SIZE, "tolerances": TOLERANCES, "views": VIEWS,
-        "view_order": list(VIEWS),
+        "cases": cases, "size": SIZE, "tolerances": TOLERANCES,
+        "views": [[name, orbit] for name, orbit in VIEWS.items()],  # in order
         "summary": {
             "cases": len(cases), "kept": sum(c["rmse"] <= c["tolerance"] for c in rendered),
             "refused": len(cases) - len(rendered),
