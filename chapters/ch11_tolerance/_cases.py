@@ -9,10 +9,9 @@ import vrlib
 
 #: Requested tolerances (rmse of premultiplied RGBA).
 TOLERANCES = [1e-2, 1e-3, 1e-4]
-#: Two views: an orthographic orbit and a perspective one from another side.
-#: Across the lattice, along its x axis (where every ray samples the lattice at the same
-#: phase: the pilots can agree while all miss what lies between their samples) and in
-#: perspective.
+#: Three views: orthographic across the lattice, orthographic along its x axis (where every
+#: ray samples the lattice at the same phase: the pilots can agree while all miss what lies
+#: between their samples), and in perspective from another side.
 VIEWS = {"orthographic": dict(azimuth=30, elevation=20),
          "along x": dict(azimuth=0, elevation=0),
          "perspective": dict(azimuth=-60, elevation=35, projection="perspective")}
