@@ -316,8 +316,9 @@ def _warp_by_numpy(inter, m, shape, grey):
 @pytest.mark.parametrize("grey, channels", [(True, 4), (True, 2), (False, 4)])
 @pytest.mark.parametrize("seed", range(3))
 def test_affine_warp_is_its_arithmetic_bit_for_bit(grey, channels, seed):
-    """The affine warp takes eight pixels at once in vector form (gathers of the four
-    neighbours, one store of the eight pixels) and the rest of a row one at a time: both
+    """The affine warp takes eight pixels at once in vector form (each pixel's neighbours
+    loaded a row at a time and transposed across the eight, one store of the eight pixels)
+    and the rest of a row one at a time: both
     must be the documented arithmetic exactly. Random intermediate images (values outside
     [0, 1] to clip, transparent patches, grey or coloured), rotated, scaled and shifted
     maps, rows whose pixels fall inside, across and outside the image, grey images also
@@ -341,3 +342,13 @@ def test_affine_warp_is_its_arithmetic_bit_for_bit(grey, channels, seed):
     expected = _warp_by_numpy(inter, m, out.shape[:2], grey)
     assert (expected[..., 3] > 0).sum() > 100  # the test sees pixels, not only margins
     np.testing.assert_array_equal(out, expected)
+
+
+@pytest.mark.parametrize("shape, grey", [((1, 5, 4), False), ((5, 1, 2), True),
+                                         ((5, 5, 2), False), ((5, 5, 3), True)])
+def test_warp_refuses_an_intermediate_image_it_cannot_read(shape, grey):
+    """The vector warp reads a pixel's two neighbours along a row as one block of channels
+    (a lane outside the image reads the first cell): fewer than 2 rows or columns, or a
+    layout of channels it does not know, would be read out of bounds, so it says so."""
+    with pytest.raises(ValueError, match="inter must be a"):
+        warp(np.zeros(shape), np.eye(3), np.empty((4, 4, 4)), grey)

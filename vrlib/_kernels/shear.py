@@ -19,7 +19,12 @@ from numba import prange
 
 from vrlib._kernels._jit import at, borrowed, helper_jit, jit, parallel_jit, put
 from vrlib._kernels.filters import CUBIC, MAX_TAPS, TENT, weight
-from vrlib._kernels.packets import LANES, warp_octet_colour, warp_octet_grey
+from vrlib._kernels.packets import (
+    LANES,
+    warp_octet_colour,
+    warp_octet_grey,
+    warp_octet_grey_pairs,
+)
 from vrlib._kernels.queue import take
 from vrlib._kernels.sampling import clamp, cubic_weights, filter_taps
 from vrlib._kernels.shading import classify_by_gradient
@@ -559,19 +564,21 @@ def _warp_octet_lanes(inter, src, mx, ax, my, ay, out, flat, row, c, grey):
 @jit(inline="always")
 def _warp_octet_compiled(inter, src, mx, ax, my, ay, out, flat, row, c, grey):
     at_out = (row * out.shape[1] + c) * 4
-    if grey:
-        warp_octet_grey(src, inter.shape[1], inter.shape[0], inter.shape[2], flat, at_out, c,
-                        mx, ax, my, ay)
+    if grey and inter.shape[2] == 2:
+        warp_octet_grey_pairs(src, inter.shape[1], inter.shape[0], flat, at_out, c, mx, ax,
+                              my, ay)
+    elif grey:
+        warp_octet_grey(src, inter.shape[1], inter.shape[0], flat, at_out, c, mx, ax, my, ay)
     else:
-        warp_octet_colour(src, inter.shape[1], inter.shape[0], inter.shape[2], flat, at_out,
-                          c, mx, ax, my, ay)
+        warp_octet_colour(src, inter.shape[1], inter.shape[0], flat, at_out, c, mx, ax, my, ay)
 
 
 warp_octet = _warp_octet_lanes if numba.config.DISABLE_JIT else _warp_octet_compiled
 """``warp_octet(inter, src, mx, ax, my, ay, out, flat, row, c, grey)``: pixels
 ``c .. c + LANES - 1`` of row ``row`` of the affine warp (:func:`warp_rows`; pixel ``c``
 samples ``inter`` at ``(mx c + ax, my c + ay)``) at once, in vector form
-(:func:`vrlib._kernels.packets.warp_octet_grey` and ``_colour``): :func:`_warp_pixel`'s
+(:func:`vrlib._kernels.packets.warp_octet_grey_pairs`, ``_grey`` and ``_colour``, for
+``inter`` of two channels or four): :func:`_warp_pixel`'s
 arithmetic lane by lane, so the image is the same bit for bit. ``inter`` and ``out``
 C-contiguous, ``src`` and ``flat`` their raveled views."""
 
