@@ -89,7 +89,7 @@ def main():
     print("## This machine's ceilings (M per second)\n")
     print(markdown(["threads", "triad GB/s", *columns.values()], rows))
     ceiling = limits[threads]
-    print("\nPackets of 8 rays sampled in vector form (gathers) against the scalar loop, "
+    print("\nPackets of 8 rays sampled in vector form against the scalar loop, "
           f"{threads} threads: float32 "
           f"{ceiling['packet_trilinear_float32'] / ceiling['trilinear_float32']:.2f}x, "
           f"float64 {ceiling['packet_trilinear_float64'] / ceiling['trilinear_float64']:.2f}x")

@@ -8,9 +8,10 @@ ceiling (``make bench``, chapter 4):
   (the ceiling of any pass that streams the volume from memory);
 * ``trilinear``: trilinear samples per second along rays inside a brick that stays in cache,
   float32 and float64 samples (the ceiling of ray casting with the tent filter);
-* ``packet_trilinear``: the same with eight rays sampled at once in vector form, gathers and
-  vector arithmetic (:mod:`vrlib._kernels.packets`): the ceiling of a packet kernel's
-  sampling, beside the scalar one;
+* ``packet_trilinear``: the same with eight rays sampled at once in vector form, each
+  lane's corner pairs loaded and transposed, and vector arithmetic
+  (:mod:`vrlib._kernels.packets`): the ceiling of a packet kernel's sampling, beside the
+  scalar one;
 * ``tricubic``: the same with a 4 x 4 x 4 Mitchell-Netravali cubic (Catmull-Rom): the
   ceiling of every 4-tap filter (the cubics, the Gaussian);
 * ``footprint``: footprint-table pixels per second drawn into a cache-resident sheet, for the

@@ -3,9 +3,12 @@
 numba has no vector types, and LLVM, as numba drives it, vectorises neither a loop over lanes
 that reads a table at eight indices nor the arithmetic around it (docs/kernel.md, "Packets").
 The functions here write the work out in LLVM's vectors instead: the eight rays' positions
-become one vector per axis; floor, fractions and base indices are vector operations; each of
-a cell's eight corners, and each table entry, is one ``llvm.masked.gather`` (an AVX2 or
-AVX-512 gather where the CPU has one, scalar loads elsewhere); the lerps run on vectors.
+become one vector per axis; floor, fractions and base indices are vector operations; what
+each lane reads lies in pairs side by side (a cell's two corners along x, a table's entry
+and the next, a pixel's two neighbours along a row), so each lane loads a pair in one
+vector and :func:`_transposed` turns the eight lanes' loads into one vector per corner or
+entry (``llvm.masked.gather``, a gather per value, took 12 to 23% longer on the Zen 4
+machine: docs/kernel.md); the lerps run on vectors.
 
 * :func:`inside_runs` is the ray caster's inner loop (:func:`vrlib._kernels.raycast.raycast`):
   each lane's run of samples inside the volume, classified from the table and composited
@@ -17,7 +20,7 @@ AVX-512 gather where the CPU has one, scalar loads elsewhere); the lerps run on 
   eight pixels of shear-warp's affine warp (:func:`vrlib._kernels.shear.warp_octet`): a
   pixel's two neighbours along a row, every channel, lie side by side, so each lane loads
   them in one vector per row and the loads are transposed into one vector per corner and
-  channel (:func:`_transposed`; gathers of each value took 30% longer); the bilinear
+  channel (gathers of each value took 30% longer); the bilinear
   weights, clipping and the transparent test as vector operations and selects (numba's own
   ``min`` and ``max`` are selects too), the eight pixels interleaved into one store. Bit for
   bit the scalar pixel's arithmetic.
@@ -80,29 +83,18 @@ def _trilinear_packet(typingctx, flat, nx, nxy, ux, uy, uz):
         plane = _splat(builder, context.cast(builder, args[2], nxy_type, types.intp), ints)
         base = builder.add(builder.add(builder.mul(cell[2], plane), builder.mul(cell[1], row)),
                            cell[0])
-        # One gather per corner, from the addresses base + offset.
+        # A cell's two neighbours along x side by side: one load of the pair per lane and row
+        # of the cell, transposed (as the renderer's packets, :func:`inside_runs`).
         size = context.get_abi_sizeof(stored)
-        start = _splat(builder, builder.ptrtoint(array.data, i64), ints)
-        loaded = ir.VectorType(stored, LANES)
-        everyone = ir.Constant(ir.VectorType(ir.IntType(1), LANES), [1] * LANES)
-        pointers = ir.VectorType(array.data.type, LANES)
-        gather = cgutils.get_or_insert_function(
-            builder.module, ir.FunctionType(loaded, [pointers, _I32, everyone.type, loaded]),
-            f"llvm.masked.gather.v{LANES}{'f64' if stored == f64 else 'f32'}.v{LANES}p0")
-
-        def corner(offset):
+        pair = ir.VectorType(stored, 2).as_pointer()
+        corners = []
+        for offset in (ir.Constant(ints, [0] * LANES), row, plane, builder.add(plane, row)):
             index = builder.add(base, offset)
-            address = builder.add(start, builder.mul(index, ir.Constant(ints, [size] * LANES)))
-            value = builder.call(gather, [builder.inttoptr(address, pointers), _I32(size),
-                                          everyone, ir.Constant(loaded, None)])
-            return value if stored == f64 else builder.fpext(value, floats)
-
-        one = ir.Constant(ints, [1] * LANES)
-        both = builder.add(plane, row)
-        d000, d001 = corner(ir.Constant(ints, [0] * LANES)), corner(one)
-        d010, d011 = corner(row), corner(builder.add(row, one))
-        d100, d101 = corner(plane), corner(builder.add(plane, one))
-        d110, d111 = corner(both), corner(builder.add(both, one))
+            corners += [value if stored == f64 else builder.fpext(value, floats)
+                        for value in _transposed(builder, [builder.load(builder.bitcast(
+                            builder.gep(array.data, [builder.extract_element(index, _I32(lane))]),
+                            pair), align=size) for lane in range(LANES)])]
+        d000, d001, d010, d011, d100, d101, d110, d111 = corners
 
         def lerp(a, b, w):
             return builder.fadd(a, builder.fmul(w, builder.fsub(b, a)))
@@ -157,18 +149,6 @@ def _row(builder, data, row, element):
                            ir.VectorType(element, LANES).as_pointer())
 
 
-def _gather(builder, function, base_address, index, item_size, mask, vector_type, align=0):
-    """``base[index]`` in each lane of ``mask`` (``base_address`` the first item's address in
-    every lane, ``index`` a vector of int64 in units of ``item_size`` bytes, each item aligned
-    to ``align`` bytes, ``item_size`` unless given), one ``llvm.masked.gather``."""
-    ints = ir.VectorType(ir.IntType(64), LANES)
-    address = builder.add(base_address, builder.mul(index, ir.Constant(ints, [item_size] * LANES)))
-    pointers = function.function_type.args[0]
-    return builder.call(function, [builder.inttoptr(address, pointers),
-                                   _I32(align or item_size), mask,
-                                   ir.Constant(vector_type, None)])
-
-
 def _mask(indices):
     """A shuffle's mask: ``indices`` into its two vectors laid end to end."""
     return ir.Constant(ir.VectorType(_I32, len(indices)), indices)
@@ -180,6 +160,14 @@ def _transposed(builder, rows):
     which AVX-512 does in one instruction (LLVM, given one long shuffle of the rows laid end
     to end, took half as many more; on VolPack's example the warp 0.21 -> 0.19 ms)."""
     first, second = [0, 1, 2, 3, 8, 9, 10, 11], [4, 5, 6, 7, 12, 13, 14, 15]
+    if rows[0].type.count == 2:
+        # Lanes side by side, four at a time, then the two elements picked apart.
+        while len(rows) > 2:
+            size = 2 * rows[0].type.count
+            rows = [builder.shuffle_vector(a, b, _mask(list(range(size))))
+                    for a, b in zip(rows[::2], rows[1::2], strict=True)]
+        return [builder.shuffle_vector(rows[0], rows[1], _mask(list(range(e, 16, 2))))
+                for e in (0, 1)]
     if rows[0].type.count == 4:
         # Lanes side by side in pairs; quads[2 h + e]: lanes 4h .. 4h + 3 of element e,
         # then of element e + 2; halves joined.
@@ -221,7 +209,7 @@ def _inside_runs_intrinsic(colour):
 
         if not (array(flat, 1, (types.float32, types.float64))
                 and array(alpha_tab, 1, (types.float64,))
-                and array(color_tab, 2, (types.float64,), contiguous=False)
+                and array(color_tab, 2, (types.float64,))
                 and array(rays, 2, (types.float64,)) and array(steps, 2, (types.int64,))
                 and all(isinstance(n, types.Integer) for n in (nx, nxy, shift))
                 and all(isinstance(x, types.Float) for x in (ds, tstart, tinv, threshold))):
@@ -240,7 +228,6 @@ def _inside_runs_intrinsic(colour):
             ray_data = context.make_array(sig[10])(context, builder, rays_v).data
             step_data = context.make_array(sig[11])(context, builder, steps_v).data
             stored = context.get_data_type(sig[0].dtype)
-            stored_vector = ir.VectorType(stored, LANES)
 
             def scalar(value, index):  # an integer argument as intp, a float as float64
                 target = types.float64 if isinstance(sig[index], types.Float) else types.intp
@@ -270,22 +257,7 @@ def _inside_runs_intrinsic(colour):
             zero_f, one_f = constant(0.0, floats), constant(1.0, floats)
             zero_i, one_i = constant(0, ints), constant(1, ints)
             volume_start = _splat(builder, builder.ptrtoint(volume.data, i64), ints)
-            alpha_start = _splat(builder, builder.ptrtoint(alpha_tab.data, i64), ints)
-            color_start = _splat(builder, builder.ptrtoint(color_tab.data, i64), ints)
-            color_row = _splat(builder, builder.extract_value(color_tab.strides, 0), ints)
-            color_column = builder.extract_value(color_tab.strides, 1)
 
-            def gather_function(element):
-                vector = ir.VectorType(element, LANES)
-                name = {f64: "f64", i64: "i64"}.get(element, "f32")
-                return cgutils.get_or_insert_function(
-                    builder.module,
-                    ir.FunctionType(vector, [ir.VectorType(element.as_pointer(), LANES), _I32,
-                                             masks, vector]),
-                    f"llvm.masked.gather.v{LANES}{name}.v{LANES}p0")
-
-            gather_volume = gather_function(stored)
-            gather_table = gather_function(f64)
             any_lane = cgutils.get_or_insert_function(
                 builder.module, ir.FunctionType(i1, [masks]), f"llvm.vector.reduce.or.v{LANES}i1")
 
@@ -326,10 +298,6 @@ def _inside_runs_intrinsic(colour):
                                                        builder.mul(cell[1], row_step)),
                                            cell[0]), shift)
 
-            def corner(offset):
-                return _gather(builder, gather_volume, volume_start, builder.add(base, offset),
-                               size, live, stored_vector)
-
             # Ask for the cells of the samples PREFETCH_AHEAD steps on: four cache lines a
             # lane (the cell's two rows in its two planes). A ray's next cells lie on new
             # lines that no hardware prefetcher foresees; without this, a packet waits for
@@ -357,24 +325,15 @@ def _inside_runs_intrinsic(colour):
                                                              byte_pointer),
                                             _I32(0), _I32(3), _I32(1)])  # read, keep, data
             both = builder.add(plane_step, row_step)
-            if stored == f64:
-                d = [corner(offset) for offset in (
-                    zero_i, one_i, row_step, builder.add(row_step, one_i), plane_step,
-                    builder.add(plane_step, one_i), both, builder.add(both, one_i))]
-            else:
-                # float32: a cell's two neighbours along x as one 8-byte item, four gathers
-                # instead of eight (the low half is the lower address's sample).
-                gather_pairs = gather_function(i64)
-                halves = ir.VectorType(stored, 2 * LANES)
-                even = ir.Constant(ir.VectorType(_I32, LANES), list(range(0, 2 * LANES, 2)))
-                odd = ir.Constant(ir.VectorType(_I32, LANES), list(range(1, 2 * LANES, 2)))
-                d = []
-                for offset in (zero_i, row_step, plane_step, both):
-                    pair = _gather(builder, gather_pairs, volume_start, builder.add(base, offset),
-                                   size, live, ir.VectorType(i64, LANES))
-                    split = builder.bitcast(pair, halves)
-                    d.append(builder.shuffle_vector(split, ir.Constant(halves, None), even))
-                    d.append(builder.shuffle_vector(split, ir.Constant(halves, None), odd))
+            # A cell's two neighbours along x lie side by side: one load of the pair per lane
+            # and row of the cell, transposed (a lane that is not live loads the first cell).
+            safe = builder.select(live, base, zero_i)
+            d = []
+            for offset in (zero_i, row_step, plane_step, both):
+                index = builder.add(safe, offset)
+                d += _transposed(builder, [builder.load(builder.bitcast(
+                    builder.gep(volume.data, [builder.extract_element(index, _I32(lane))]),
+                    ir.VectorType(stored, 2).as_pointer()), align=size) for lane in range(LANES)])
 
             def widen(value):
                 return value if stored == f64 else builder.fpext(value, floats)
@@ -397,25 +356,29 @@ def _inside_runs_intrinsic(colour):
             row = builder.select(positive, builder.select(beyond, last_i, floor), zero_i)
             weight = builder.select(positive, builder.select(
                 beyond, one_f, builder.fsub(x, builder.sitofp(floor, floats))), zero_f)
-            next_row = builder.add(row, one_i)
-
-            left = _gather(builder, gather_table, alpha_start, row, 8, live, floats)
-            right = _gather(builder, gather_table, alpha_start, next_row, 8, live, floats)
+            # A row and the next side by side: one load per lane (every lane's row lies in
+            # the table, a lane that is not live reads row 0), transposed.
+            left, right = _transposed(builder, [builder.load(builder.bitcast(
+                builder.gep(alpha_tab.data, [builder.extract_element(row, _I32(lane))]),
+                ir.VectorType(f64, 2).as_pointer()), align=8) for lane in range(LANES)])
             alpha = builder.fadd(left, builder.fmul(weight, builder.fsub(right, left)))
             # Front to back over (eqs 1.7-1.8) where the segment is not transparent.
             take = builder.and_(active, builder.fcmp_ordered(">", alpha, zero_f))
             remaining = builder.fsub(one_f, acc[3])
             if colour:
-                colours = []
-                for channel in range(3):
-                    # color_tab[i, channel]: i rows of color_row bytes, then the column.
-                    start = builder.add(color_start, _splat(
-                        builder, builder.mul(color_column, i64(channel)), ints))
-                    lo = _gather(builder, gather_table, start, builder.mul(row, color_row), 1,
-                                 live, floats, 8)
-                    hi = _gather(builder, gather_table, start,
-                                 builder.mul(next_row, color_row), 1, live, floats, 8)
-                    colours.append(builder.fadd(lo, builder.fmul(weight, builder.fsub(hi, lo))))
+                # The (n, 3) table's row and the next, six floats side by side: per lane one
+                # load of four and one of two, transposed.
+                def rows(first, count):
+                    return _transposed(builder, [builder.load(builder.bitcast(builder.gep(
+                        color_tab.data, [builder.add(builder.mul(builder.extract_element(
+                            row, _I32(lane)), i64(3)), i64(first))]),
+                        ir.VectorType(f64, count).as_pointer()), align=8)
+                        for lane in range(LANES)])
+
+                r0, g0, b0, r1 = rows(0, 4)
+                g1, b1 = rows(4, 2)
+                colours = [builder.fadd(lo, builder.fmul(weight, builder.fsub(hi, lo)))
+                           for lo, hi in ((r0, r1), (g0, g1), (b0, b1))]
                 over = [builder.fadd(acc[c], builder.fmul(remaining, colours[c]))
                         for c in range(3)]
             else:
