@@ -20,10 +20,10 @@ machine: docs/kernel.md); the lerps run on vectors.
   eight pixels of shear-warp's affine warp (:func:`vrlib._kernels.shear.warp_octet`): a
   pixel's two neighbours along a row, every channel, lie side by side, so each lane loads
   them in one vector per row and the loads are transposed into one vector per corner and
-  channel (gathers of each value took 30% longer); the bilinear
-  weights, clipping and the transparent test as vector operations and selects (numba's own
-  ``min`` and ``max`` are selects too), the eight pixels interleaved into one store. Bit for
-  bit the scalar pixel's arithmetic.
+  channel (gathers of each value took 30% longer); the bilinear weights, clipping and the
+  transparent test as vector operations and selects (numba's own ``min`` and ``max`` are
+  selects too), the eight pixels interleaved into one store. Bit for bit the scalar pixel's
+  arithmetic.
 * :func:`trilinear_packet` is one trilinear sample of eight rays: the roofline measures it
   beside the scalar loop (:mod:`vrlib.roofline`), the packet-sampling ceiling. It widens
   float32 samples before their differences (within float32 rounding of the scalar loop).
@@ -155,10 +155,10 @@ def _mask(indices):
 
 
 def _transposed(builder, rows):
-    """The ``LANES`` vectors ``rows``, one per lane of 4 or 8 elements each, as one vector
-    per element of ``LANES`` lanes: a transpose in rounds of two-vector shuffles, each of
-    which AVX-512 does in one instruction (LLVM, given one long shuffle of the rows laid end
-    to end, took half as many more; on VolPack's example the warp 0.21 -> 0.19 ms)."""
+    """The ``LANES`` (8) vectors ``rows``, one per lane of 2, 4 or 8 elements each, as one
+    vector per element of ``LANES`` lanes: a transpose in rounds of two-vector shuffles, each
+    of which AVX-512 does in one instruction (given one long shuffle of the rows laid end to
+    end, LLVM took more: on VolPack's example the warp 0.21 against 0.19 ms)."""
     first, second = [0, 1, 2, 3, 8, 9, 10, 11], [4, 5, 6, 7, 12, 13, 14, 15]
     if rows[0].type.count == 2:
         # Lanes side by side, four at a time, then the two elements picked apart.
@@ -485,8 +485,9 @@ equal: an idle lane) of the ray at index positions ``a + ((k + 1/2) ds) b`` (``a
 in rows ``AX..AZ`` and ``BX..BZ`` of ``rays``), every one in a cell whose eight corners lie in
 ``flat`` (a raveled ``[z, y, x]`` volume or brick, float32 or float64, rows of ``nx`` samples,
 planes of ``nxy``, global flat index minus ``shift``). Each sample's value is classified by the
-table ``alpha_tab`` over ``(value - tstart) tinv`` (and colour from ``color_tab``'s rows
-unless ``grey``: then the colour is the opacity), and composited front to back onto rows
+table ``alpha_tab`` over ``(value - tstart) tinv`` (and colour from the C-contiguous
+``(n, 3)`` ``color_tab``'s rows unless ``grey``: then the colour is the opacity; both tables
+of at least 2 rows), and composited front to back onto rows
 ``RED..ALPHA``, until the lane's opacity reaches ``threshold``. On return ``steps[K]`` holds
 each lane's next sample and ``rays`` its colour and opacity."""
 
