@@ -318,12 +318,11 @@ def _warp_by_numpy(inter, m, shape, grey):
 def test_affine_warp_is_its_arithmetic_bit_for_bit(grey, channels, seed):
     """The affine warp takes eight pixels at once in vector form (each pixel's neighbours
     loaded a row at a time and transposed across the eight, one store of the eight pixels)
-    and the rest of a row one at a time: both
-    must be the documented arithmetic exactly. Random intermediate images (values outside
-    [0, 1] to clip, transparent patches, grey or coloured), rotated, scaled and shifted
-    maps, rows whose pixels fall inside, across and outside the image, grey images also
-    as red and opacity alone (the classified renderer's); compared bit for bit with numpy's
-    whole-array arithmetic."""
+    and the rest of a row one at a time: both must be the documented arithmetic exactly.
+    Random intermediate images (values outside [0, 1] to clip, transparent patches, grey or
+    coloured), rotated, scaled and shifted maps, rows whose pixels fall inside, across and
+    outside the image, grey images also as red and opacity alone (the classified
+    renderer's); compared bit for bit with numpy's whole-array arithmetic."""
     rng = np.random.default_rng(seed)
     inter = rng.random((37, 45, 4)) * 1.4 - 0.2
     inter[rng.random((37, 45)) < 0.3] = 0.0

@@ -578,9 +578,9 @@ warp_octet = _warp_octet_lanes if numba.config.DISABLE_JIT else _warp_octet_comp
 ``c .. c + LANES - 1`` of row ``row`` of the affine warp (:func:`warp_rows`; pixel ``c``
 samples ``inter`` at ``(mx c + ax, my c + ay)``) at once, in vector form
 (:func:`vrlib._kernels.packets.warp_octet_grey_pairs`, ``_grey`` and ``_colour``, for
-``inter`` of two channels or four): :func:`_warp_pixel`'s
-arithmetic lane by lane, so the image is the same bit for bit. ``inter`` and ``out``
-C-contiguous, ``src`` and ``flat`` their raveled views."""
+``inter`` of two channels or four): :func:`_warp_pixel`'s arithmetic lane by lane, so the
+image is the same bit for bit. ``inter`` and ``out`` C-contiguous, ``src`` and ``flat``
+their raveled views."""
 
 
 @jit(inline="always")
