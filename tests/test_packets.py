@@ -60,11 +60,13 @@ def test_packet_runs_equal_the_scalar_loop_lane_by_lane(dtype, grey, threshold):
     rays, steps, ds = lanes_in_a_volume(rng, shape, groups=12, shift=shift)
     expected_rays, expected_steps = rays.copy(), steps.copy()
     compiled = packets._inside_runs_compiled
+    colour = None if grey else True  # None: the colour is the opacity
     for g in range(len(rays)):
-        compiled(flat, nx, nxy, shift * nxy, alpha_tab, color_tab, grey, ds, -0.05, 60.0,
+        compiled(flat, nx, nxy, shift * nxy, alpha_tab, color_tab, colour, ds, -0.05, 60.0,
                  threshold, rays[g], steps[g])
-        packets._inside_runs_lanes(flat, nx, nxy, shift * nxy, alpha_tab, color_tab, grey, ds,
-                                   -0.05, 60.0, threshold, expected_rays[g], expected_steps[g])
+        packets._inside_runs_lanes(flat, nx, nxy, shift * nxy, alpha_tab, color_tab, colour,
+                                   ds, -0.05, 60.0, threshold, expected_rays[g],
+                                   expected_steps[g])
     np.testing.assert_array_equal(steps, expected_steps)
     np.testing.assert_array_equal(rays, expected_rays)
     taken = steps[:, K] > 0

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 
-from vrlib._kernels._jit import jit
+from vrlib._kernels._jit import helper_jit, jit
 
 CENTER, RIGHT, UP, FORWARD = 0, 3, 6, 9
 PIXEL, RADIUS, DISTANCE = 12, 13, 14
@@ -63,14 +63,14 @@ def pixel_ray(camera, height, width, r, c):
     return o, (dx / norm, dy / norm, dz / norm)
 
 
-@jit
+@helper_jit
 def on_plane(camera, x, y, z):
     """Components of the offset ``(x, y, z)`` along ``RIGHT`` and ``UP``."""
     return (x * camera[RIGHT] + y * camera[RIGHT + 1] + z * camera[RIGHT + 2],
             x * camera[UP] + y * camera[UP + 1] + z * camera[UP + 2])
 
 
-@jit
+@helper_jit
 def camera_coords(camera, x, y, z):
     """``(right, up, depth)`` of a world point, measured from where rays start."""
     o = start(camera)
@@ -82,7 +82,7 @@ def camera_coords(camera, x, y, z):
             sx * camera[FORWARD] + sy * camera[FORWARD + 1] + sz * camera[FORWARD + 2])
 
 
-@jit
+@helper_jit
 def project(camera, height, width, x, y, z):
     """Continuous image position ``(row, col)`` and depth of a world point (as
     :meth:`vrlib.View.project`); NaN position behind a perspective eye."""

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 
-from vrlib._kernels._jit import jit
+from vrlib._kernels._jit import helper_jit, jit
 
 BOX, TENT, GAUSSIAN, CUBIC = 0, 1, 2, 3
 #: Most taps per axis a kernel takes (scratch arrays hold this many): filter radii up to 4.
@@ -42,13 +42,13 @@ def cubic_coefficients(b, c, d):
     return near, far
 
 
-@jit
+@helper_jit
 def cubic_piece(p, x):
     """A cubic piece of :func:`cubic_coefficients` at ``x >= 0`` (still times 6)."""
     return p[3] * x * x * x + p[2] * x * x + p[1] * x + p[0]
 
 
-@jit
+@helper_jit
 def cubic_piece_slope(p, x):
     """The derivative of :func:`cubic_piece` at ``x`` (still times 6)."""
     return 3.0 * p[3] * x * x + 2.0 * p[2] * x + p[1]

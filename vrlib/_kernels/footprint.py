@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-from vrlib._kernels._jit import at, jit
+from vrlib._kernels._jit import at, helper_jit, jit
 from vrlib._kernels.filters import weight
 from vrlib._kernels.queue import take
 
@@ -53,7 +53,7 @@ def planar_at(extent, planar, j, ty, u):
             + ty * ((1.0 - tx) * at(planar, (j + 1, i)) + tx * at(planar, (j + 1, i + 1))))
 
 
-@jit
+@helper_jit
 def sort_prefix(values, count):
     """Sort ``values[:count]`` in place, ascending: insertion sort, for the few dozen cuts of
     a line integral (numba's own sort costs two seconds of a first render's compile).

@@ -417,7 +417,7 @@ def _inside_runs_intrinsic(colour):
     return runs
 
 
-def _inside_runs_lanes(flat, nx, nxy, shift, alpha_tab, color_tab, grey, ds, tstart, tinv,
+def _inside_runs_lanes(flat, nx, nxy, shift, alpha_tab, color_tab, colour, ds, tstart, tinv,
                        threshold, rays, steps):
     """:func:`inside_runs` one lane at a time (without the JIT): the scalar loop."""
     n = alpha_tab.shape[0]
@@ -446,7 +446,7 @@ def _inside_runs_lanes(flat, nx, nxy, shift, alpha_tab, color_tab, grey, ds, tst
             k += 1
             if alpha > 0.0:
                 remaining = 1.0 - a
-                if grey:
+                if colour is None:
                     r += remaining * alpha
                     g = b = r
                 else:
@@ -466,9 +466,9 @@ _runs_colour = _inside_runs_intrinsic(colour=True)
 
 
 @jit(inline="always")
-def _inside_runs_compiled(flat, nx, nxy, shift, alpha_tab, color_tab, grey, ds, tstart, tinv,
-                          threshold, rays, steps):
-    if grey:
+def _inside_runs_compiled(flat, nx, nxy, shift, alpha_tab, color_tab, colour, ds, tstart,
+                          tinv, threshold, rays, steps):
+    if colour is None:
         _runs_grey(flat, nx, nxy, shift, alpha_tab, color_tab, ds, tstart, tinv, threshold,
                    rays, steps)
     else:
@@ -477,7 +477,7 @@ def _inside_runs_compiled(flat, nx, nxy, shift, alpha_tab, color_tab, grey, ds, 
 
 
 inside_runs = _inside_runs_lanes if numba.config.DISABLE_JIT else _inside_runs_compiled
-"""``inside_runs(flat, nx, nxy, shift, alpha_tab, color_tab, grey, ds, tstart, tinv,
+"""``inside_runs(flat, nx, nxy, shift, alpha_tab, color_tab, colour, ds, tstart, tinv,
 threshold, rays, steps)``: ``LANES`` rays' runs of samples inside the volume at once.
 
 Lane ``l`` takes samples ``k = steps[K, l]`` up to ``steps[END, l]`` (none where they are
@@ -486,9 +486,10 @@ in rows ``AX..AZ`` and ``BX..BZ`` of ``rays``), every one in a cell whose eight 
 ``flat`` (a raveled ``[z, y, x]`` volume or brick, float32 or float64, rows of ``nx`` samples,
 planes of ``nxy``, global flat index minus ``shift``). Each sample's value is classified by the
 table ``alpha_tab`` over ``(value - tstart) tinv`` (and colour from the C-contiguous
-``(n, 3)`` ``color_tab``'s rows unless ``grey``: then the colour is the opacity; both tables
-of at least 2 rows), and composited front to back onto rows
-``RED..ALPHA``, until the lane's opacity reaches ``threshold``. On return ``steps[K]`` holds
+``(n, 3)`` ``color_tab``'s rows where ``colour`` is True; where it is None the colour is
+the opacity, and the kernel is compiled without the colour's loads; both tables of at least
+2 rows), and composited front to back onto rows ``RED..ALPHA``, until the lane's opacity
+reaches ``threshold``. On return ``steps[K]`` holds
 each lane's next sample and ``rays`` its colour and opacity."""
 
 

@@ -11,10 +11,10 @@ from __future__ import annotations
 import numpy as np
 from numba import prange
 
-from vrlib._kernels._jit import jit, parallel_jit
+from vrlib._kernels._jit import helper_jit, parallel_jit
 
 
-@jit
+@helper_jit
 def _causal_start(line, n, pole, terms):
     """``sum_k p^k f_{-k}`` over the half-sample symmetric extension of ``line[:n]``:
     ``f_0, f_0, f_1, ..., f_{n-1}, f_{n-1}, ..., f_1`` (period ``2n``), ``terms`` terms; a
@@ -35,7 +35,7 @@ def _causal_start(line, n, pole, terms):
     return total
 
 
-@jit
+@helper_jit
 def filter_line(line, n, poles, terms):
     """The prefilter on ``line[:n]`` (float64), in place: per pole, the gain, the causal
     recursion ``y_k = g f_k + p y_{k-1}`` and the anticausal ``c_k = p (c_{k+1} - y_k)``."""

@@ -192,10 +192,11 @@ def _put_pixel(out, r, c, red, green, blue, alpha):
     out[r, c, 3] = min(max(alpha, 0.0), 1.0)
 
 
-@jit(inline="always")
+@helper_jit
 def _before(t_check, ds, k, end):
     """``end`` cut to the first sample after ``k`` at or past ``t_check`` (the general
-    loop's next skip check; none when it is infinite)."""
+    loop's next skip check; none when it is infinite). Compiled apart, as
+    :func:`_inside_end`."""
     if not (-math.inf < t_check < math.inf):
         return end
     limit = max(math.ceil(t_check / ds - 0.5), k + 1)
@@ -206,13 +207,14 @@ def _before(t_check, ds, k, end):
     return min(end, limit)
 
 
-@jit(inline="always")
+@helper_jit
 def _inside_end(k, ds, ax, ay, az, bx, by, bz, gx1, gy1, gz1, t_in, t_out, k_last):
     """End (exclusive) of the run of samples from ``k`` on that are :func:`_inside` and
     before the cut segment ``k_last`` (-1: none), for a sample ``k`` that is. A sample's
     index position, as computed, is monotone in ``k`` (rounding keeps the order of exact
     values), so the run is one interval: guessed from where the ray leaves the cells, then
-    corrected by testing its end."""
+    corrected by testing its end. Compiled once, apart from the kernel that calls it once a
+    run: inlined, it and :func:`_before` cost a first render 0.25 s of compile."""
     t_end = t_out
     for a, b, g1 in ((ax, bx, gx1), (ay, by, gy1), (az, bz, gz1)):
         if b > 0.0:
@@ -454,6 +456,10 @@ def _step_segment(front, back, length, start, inv, density, emission, grey):
             half_a * front_b + behind * back_b)
 
 
+#: :func:`_pixel_start`'s result for a ray that meets nothing.
+_NO_START = (False, (0.0, 0.0, 0.0), 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, -1, -1, 0.0, 0.0)
+
+
 @jit(inline="always")
 def _pixel_start(r, c, camera, height, width, mask, box_lo, box_hi, vol_lo, vol_hi, exact,
                  origin, inv, ds):
@@ -461,16 +467,14 @@ def _pixel_start(r, c, camera, height, width, mask, box_lo, box_hi, vol_lo, vol_
     ``(hit, d, t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, t_first, t_last)``.
     ``hit`` is False for a pixel outside the image or the ``mask``, or a ray that misses the
     box ``[box_lo, box_hi]``; ``d`` is the ray's direction, ``[t_in, t_out)`` its stretch in
-    the box, ``a + t b`` its index position, ``k`` the first segment; with ``exact``, the
-    segments ``k_first`` and ``k_last`` that the volume's faces cut at ``t_first`` and
-    ``t_last`` (-1 without; a cut segment's sample may lie before segment ``k``'s, so ``k``
-    starts there)."""
+    the box, ``a + t b`` its index position, ``k`` the first segment; with ``exact`` True
+    (None: without), the segments ``k_first`` and ``k_last`` that the volume's faces cut at
+    ``t_first`` and ``t_last`` (-1 without; a cut segment's sample may lie before segment
+    ``k``'s, so ``k`` starts there)."""
     if r >= height or c >= width:
-        return (False, (0.0, 0.0, 0.0), 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, -1, -1,
-                0.0, 0.0)
+        return _NO_START
     if not mask[r, c]:  # a ray that meets nothing visible: no set-up at all
-        return (False, (0.0, 0.0, 0.0), 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, -1, -1,
-                0.0, 0.0)
+        return _NO_START
     o, d = pixel_ray(camera, height, width, r, c)
     t_in, t_out = ray_box(o, d, box_lo, box_hi)
     t_in = max(t_in, 0.0)
@@ -484,7 +488,7 @@ def _pixel_start(r, c, camera, height, width, mask, box_lo, box_hi, vol_lo, vol_
     k = math.ceil(t_in / ds - 0.5) if t_out > t_in else 0
     k_first = k_last = -1
     t_first = t_last = 0.0
-    if exact and t_out > t_in:
+    if exact is not None and t_out > t_in:
         t_first, t_last = ray_box(o, d, vol_lo, vol_hi)
         t_first = max(t_first, 0.0)
         k_first = math.floor(t_first / ds)
@@ -493,6 +497,16 @@ def _pixel_start(r, c, camera, height, width, mask, box_lo, box_hi, vol_lo, vol_
             k -= 1
     hit = t_out > t_in
     return hit, d, t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, t_first, t_last
+
+
+@helper_jit
+def _pixel_start_apart(r, c, camera, height, width, mask, box_lo, box_hi, vol_lo, vol_hi,
+                       exact, origin, inv, ds):
+    """:func:`_pixel_start` compiled once, for the kernel of small renders to call: inlined,
+    it cost their first render 0.4 s of compile, while the call costs a ray some 30 ns (5%
+    of a dense 512^2 render, whose kernel inlines it)."""
+    return _pixel_start(r, c, camera, height, width, mask, box_lo, box_hi, vol_lo, vol_hi,
+                        exact, origin, inv, ds)
 
 
 @jit(inline="always")
@@ -594,8 +608,8 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
             tstart, tinv, alpha_tab, color_tab, emit_tab,
             shade, ka, kd, ks, shininess, light, headlight, ramp_x, ramp_y, by_gradient,
             threshold, empty, clearance, block, mask, bound, budget, multiplier, tile_h, tile_w,
-            order, counter, out, samples, grey, filtering, lighting, skipping, packets, scratch,
-            rays, steps, ray_state, ray_steps, status):
+            order, counter, out, samples, colour, filtering, lighting, skipping, packets, small,
+            scratch, rays, steps, ray_state, ray_steps, status):
     """Render ``out[row, col] = (r, g, b, a)`` premultiplied (``out`` comes transparent: a
     pixel whose ray meets nothing, and a tile left out of ``order``, stay so); count samples
     per tile.
@@ -604,14 +618,14 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
     with ghost samples) of a volume of global shape ``gshape`` whose sample 0 is at world
     ``origin``; the rays of the packed view ``camera`` (one per pixel of a ``height x width``
     image) sample the world box ``[box_lo, box_hi]`` of a volume whose own box is
-    ``[vol_lo, vol_hi]`` (cut exactly at its faces when ``exact``). The image is cut into
-    ``tile_h x tile_w`` pixel tiles; a call takes the next tile of ``order`` (the heaviest
-    first) from the shared queue ``counter`` (:func:`vrlib._kernels.queue.take`) until none
-    is left. Several threads make the call at once (:func:`vrlib._scheduling.on_threads`;
-    the kernel releases the GIL) and finish together however unevenly the tiles cost;
-    neighbouring rays read neighbouring voxels, so a tile keeps them in cache. Each pixel is
-    computed independently and in a fixed order: the image depends neither on the number of
-    threads nor on which thread took which tile.
+    ``[vol_lo, vol_hi]`` (cut exactly at its faces when ``exact`` is True; None compiles the
+    kernel without the cuts). The image is cut into ``tile_h x tile_w`` pixel tiles; a call
+    takes the next tile of ``order`` (the heaviest first) from the shared queue ``counter``
+    (:func:`vrlib._kernels.queue.take`) until none is left. Several threads make the call at
+    once (:func:`vrlib._scheduling.on_threads`; the kernel releases the GIL) and finish
+    together however unevenly the tiles cost; neighbouring rays read neighbouring voxels, so
+    a tile keeps them in cache. Each pixel is computed independently and in a fixed order:
+    the image depends neither on the number of threads nor on which thread took which tile.
 
     Skips: ``empty`` flags blocks of ``block`` cells per axis that nothing visible can come
     from, and ``clearance`` (per block, an integer array of the same shape) how far a ray
@@ -624,21 +638,25 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
     Adaptive steps: where ``multiplier`` (per block of the skip grid, a power of two; a
     ``(1, 1, 1)`` array of 1 turns them off) exceeds 1, one sample stands for that many
     segments (:func:`_long_segment`, :mod:`vrlib.adaptive`).
-    ``grey`` says the emission is 1 everywhere and unshaded, so colour equals opacity.
-    ``by_gradient`` multiplies the density by the piecewise-linear factor through
-    ``(ramp_x, ramp_y)`` of the gradient magnitude (per world unit).
+    ``colour`` None says the emission is 1 everywhere and unshaded, so colour equals
+    opacity (True: the colour comes from ``color_tab`` or the shading). ``by_gradient``
+    multiplies the density by the piecewise-linear factor through ``(ramp_x, ramp_y)`` of
+    the gradient magnitude (per world unit).
 
     Compiled per kind of render: ``filtering`` None compiles only the tent filter,
-    ``lighting`` None only a table's colour (no shading, no gradient opacity), and
-    ``skipping`` None leaves out the skipping (``block = 0``). numba drops a branch on a
-    None argument before it types the function, so such a kernel compiles in a fraction of
-    the time (a first render's wait); ``True`` compiles that path. ``packets`` True (for
-    the tent filter without shading: ``filtering`` and ``lighting`` None) compiles the
-    packets below, None leaves them out (a branch on ``True`` is typed and compiled whether
-    taken or not: only a None argument drops one). ``scratch``
-    (6 x ``MAX_TAPS``, this call's own) holds the filter's weights and their derivatives
-    along x, y and z; ``rays, steps, ray_state, ray_steps, status`` are this call's lanes
-    (:func:`lanes`).
+    ``lighting`` None only a table's colour (no shading, no gradient opacity), ``colour``
+    None no colour at all, and ``skipping`` None leaves out the skipping (``block = 0``).
+    numba drops a branch on a None argument before it types the function, so such a kernel
+    compiles in a fraction of the time (a first render's wait); ``True`` compiles that path.
+    ``packets`` True (for the tent filter without shading: ``filtering`` and ``lighting``
+    None) compiles the packets below, None leaves them out (a branch on ``True`` is typed
+    and compiled whether taken or not: only a None argument drops one). ``small`` is True
+    exactly when ``filtering``, ``lighting`` and ``packets`` are all None (the kernel of
+    small renders, :data:`vrlib.raycast.PACKET_SAMPLES`: it calls
+    :func:`_pixel_start_apart` where the others inline :func:`_pixel_start`), else None.
+    ``scratch`` (6 x ``MAX_TAPS``, this call's own) holds the filter's weights and their
+    derivatives along x, y and z; ``rays, steps, ray_state, ray_steps, status`` are this
+    call's lanes (:func:`lanes`).
 
     Rays go in groups of ``LANES`` pixels of a tile row. Each ray is marched alone (the
     checked samples: cut segments, borders, skips, other filters, shading) up to where its
@@ -687,9 +705,17 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                 c = col0 + (p0 + lane) % tile_w
                 if p0 + lane >= tile_h * tile_w:
                     continue
+                # Called in the kernel of small renders, inlined in the others (the two
+                # tests drop one branch or the other before typing: see below).
+                start = _NO_START
+                if small is not None:
+                    start = _pixel_start_apart(r, c, camera, height, width, mask, box_lo,
+                                               box_hi, vol_lo, vol_hi, exact, origin, inv, ds)
+                if packets is not None or filtering is not None or lighting is not None:
+                    start = _pixel_start(r, c, camera, height, width, mask, box_lo, box_hi,
+                                         vol_lo, vol_hi, exact, origin, inv, ds)
                 hit, d, t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, t_first, \
-                    t_last = _pixel_start(r, c, camera, height, width, mask, box_lo, box_hi,
-                                          vol_lo, vol_hi, exact, origin, inv, ds)
+                    t_last = start
                 if not hit:
                     continue
                 status[lane] = MARCH
@@ -730,7 +756,7 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                     while True:
                         t = (k + 0.5) * ds
                         fraction = 1.0
-                        if k == k_first or k == k_last:
+                        if exact is not None and (k == k_first or k == k_last):
                             t, fraction = _cut_segment(k, ds, t_first, t_last)
                             if t < t_in:  # another brick's sample
                                 k += 1
@@ -803,7 +829,7 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                         alpha = entry(alpha_tab, i, w)
                         if not alpha > 0.0:
                             continue  # a transparent segment adds exactly nothing
-                        if grey and not by_gradient:
+                        if colour is None and (lighting is None or not by_gradient):
                             cr = cg = cb = alpha  # white emission, no shading: colour = opacity
                         elif lighting is not None and (shade or by_gradient):
                             gx_, gy_, gz_ = gradient(data, offset, gshape, ux, uy, uz, fkind,
@@ -823,7 +849,8 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                             cr = entry_channel(color_tab, i, w, 0)
                             cg = entry_channel(color_tab, i, w, 1)
                             cb = entry_channel(color_tab, i, w, 2)
-                        if fraction != 1.0:  # a segment cut by the volume's face, or a long one
+                        # A segment cut by the volume's face, or a long one.
+                        if (exact is not None or skipping is not None) and fraction != 1.0:
                             part = _part_of_segment(alpha, fraction)
                             cr *= part / alpha
                             cg *= part / alpha
@@ -856,7 +883,7 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                     waiting = waiting or status[lane] == RUN
                 if not waiting:
                     break
-                inside_runs(flat, nx, nxy, shift, alpha_tab, color_tab, grey, ds, tstart,
+                inside_runs(flat, nx, nxy, shift, alpha_tab, color_tab, colour, ds, tstart,
                             tinv, threshold, rays, steps)
                 for lane in range(LANES):
                     if status[lane] != RUN:

@@ -7,7 +7,7 @@ segment_table`, :meth:`~vrlib.TransferFunction.value_table`); a value becomes a 
 
 from __future__ import annotations
 
-from vrlib._kernels._jit import at, jit
+from vrlib._kernels._jit import at, helper_jit, jit
 
 
 @jit(inline="always")
@@ -35,21 +35,21 @@ def entry_channel(tab, i, w, channel):
     return at(tab, (i, channel)) + w * (at(tab, (i + 1, channel)) - at(tab, (i, channel)))
 
 
-@jit
+@helper_jit
 def interpolate(tab, start, inv, value):
     """1-D table ``tab`` at ``value``, linearly interpolated and clamped."""
     i, w = lookup((value - start) * inv, tab.shape[0])
     return entry(tab, i, w)
 
 
-@jit
+@helper_jit
 def interpolate_channel(tab, start, inv, value, channel):
     """Column ``channel`` of the 2-D table ``tab`` at ``value``, as :func:`interpolate`."""
     i, w = lookup((value - start) * inv, tab.shape[0])
     return entry_channel(tab, i, w, channel)
 
 
-@jit
+@helper_jit
 def interpolate_rgb(tab, start, inv, value):
     """Columns 0, 1 and 2 of the 2-D table ``tab`` at ``value``, as :func:`interpolate`: one
     compiled function (:func:`interpolate_channel` called with the constants 0, 1 and 2 is
@@ -58,7 +58,7 @@ def interpolate_rgb(tab, start, inv, value):
     return entry_channel(tab, i, w, 0), entry_channel(tab, i, w, 1), entry_channel(tab, i, w, 2)
 
 
-@jit
+@helper_jit
 def piecewise_linear(xs, ys, x):
     """The piecewise-linear function through points ``(xs, ys)`` (``xs`` increasing) at ``x``,
     constant beyond the ends (as ``numpy.interp``); a short table, searched in order."""
