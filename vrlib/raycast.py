@@ -316,12 +316,18 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
         small = None
         if packets and plan.rays * (plan.diagonal / ds + 2.0) < PACKET_SAMPLES:
             packets, small = None, True  # too few samples to repay compiling the packets
-        arguments = (*plan.layout, True if exact_ends else None, view.packed(), view.height,
+        # The tent filter unlit (a first render's kernel) is compiled without what a render
+        # does not use: the colour of a grey table, the cut segments of lattice ends (None);
+        # the other kernels take them as flags, one kernel for both.
+        plain = filtering is None and lit is None
+        colour = None if grey and plain else True
+        exact = (True if exact_ends else None) if plain else bool(exact_ends)
+        arguments = (*plan.layout, exact, view.packed(), view.height,
                      view.width, ds, *filt.code, filt.radius, filt.taps, *tables, *plan.lighting,
                      *plan.by_gradient, *skips,
                      readonly(vector(_NO_MULTIPLIER if multiplier is None else multiplier,
                                      np.int64)),
-                     *tiles, None if grey else True, filtering, lit, skipping, packets, small)
+                     *tiles, colour, filtering, lit, skipping, packets, small)
         on_threads(lambda i: _kernel.raycast(*arguments, plan.scratch[i],
                                              *(a[i] for a in plan.lanes)), plan.threads)
     return out, int(samples.sum())  # the kernels clip each pixel's opacity

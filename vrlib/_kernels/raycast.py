@@ -468,9 +468,9 @@ def _pixel_start(r, c, camera, height, width, mask, box_lo, box_hi, vol_lo, vol_
     ``hit`` is False for a pixel outside the image or the ``mask``, or a ray that misses the
     box ``[box_lo, box_hi]``; ``d`` is the ray's direction, ``[t_in, t_out)`` its stretch in
     the box, ``a + t b`` its index position, ``k`` the first segment; with ``exact`` True
-    (None: without), the segments ``k_first`` and ``k_last`` that the volume's faces cut at
-    ``t_first`` and ``t_last`` (-1 without; a cut segment's sample may lie before segment
-    ``k``'s, so ``k`` starts there)."""
+    (False or None: without), the segments ``k_first`` and ``k_last`` that the volume's
+    faces cut at ``t_first`` and ``t_last`` (-1 without; a cut segment's sample may lie
+    before segment ``k``'s, so ``k`` starts there)."""
     if r >= height or c >= width:
         return _NO_START
     if not mask[r, c]:  # a ray that meets nothing visible: no set-up at all
@@ -488,7 +488,7 @@ def _pixel_start(r, c, camera, height, width, mask, box_lo, box_hi, vol_lo, vol_
     k = math.ceil(t_in / ds - 0.5) if t_out > t_in else 0
     k_first = k_last = -1
     t_first = t_last = 0.0
-    if exact is not None and t_out > t_in:
+    if exact is not None and exact and t_out > t_in:
         t_first, t_last = ray_box(o, d, vol_lo, vol_hi)
         t_first = max(t_first, 0.0)
         k_first = math.floor(t_first / ds)
@@ -618,14 +618,15 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
     with ghost samples) of a volume of global shape ``gshape`` whose sample 0 is at world
     ``origin``; the rays of the packed view ``camera`` (one per pixel of a ``height x width``
     image) sample the world box ``[box_lo, box_hi]`` of a volume whose own box is
-    ``[vol_lo, vol_hi]`` (cut exactly at its faces when ``exact`` is True; None compiles the
-    kernel without the cuts). The image is cut into ``tile_h x tile_w`` pixel tiles; a call
-    takes the next tile of ``order`` (the heaviest first) from the shared queue ``counter``
-    (:func:`vrlib._kernels.queue.take`) until none is left. Several threads make the call at
-    once (:func:`vrlib._scheduling.on_threads`; the kernel releases the GIL) and finish
-    together however unevenly the tiles cost; neighbouring rays read neighbouring voxels, so
-    a tile keeps them in cache. Each pixel is computed independently and in a fixed order:
-    the image depends neither on the number of threads nor on which thread took which tile.
+    ``[vol_lo, vol_hi]`` (cut exactly at its faces when ``exact`` is True; None, not False,
+    compiles the kernel without the cuts). The image is cut into ``tile_h x tile_w`` pixel
+    tiles; a call takes the next tile of ``order`` (the heaviest first) from the shared queue
+    ``counter`` (:func:`vrlib._kernels.queue.take`) until none is left. Several threads make
+    the call at once (:func:`vrlib._scheduling.on_threads`; the kernel releases the GIL) and
+    finish together however unevenly the tiles cost; neighbouring rays read neighbouring
+    voxels, so a tile keeps them in cache. Each pixel is computed independently and in a fixed
+    order: the image depends neither on the number of threads nor on which thread took which
+    tile.
 
     Skips: ``empty`` flags blocks of ``block`` cells per axis that nothing visible can come
     from, and ``clearance`` (per block, an integer array of the same shape) how far a ray
@@ -639,7 +640,8 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
     ``(1, 1, 1)`` array of 1 turns them off) exceeds 1, one sample stands for that many
     segments (:func:`_long_segment`, :mod:`vrlib.adaptive`).
     ``colour`` None says the emission is 1 everywhere and unshaded, so colour equals
-    opacity (True: the colour comes from ``color_tab`` or the shading). ``by_gradient``
+    opacity (True: the colour comes from ``color_tab``, equal to the opacity table's for a
+    grey table, or the shading). ``by_gradient``
     multiplies the density by the piecewise-linear factor through ``(ramp_x, ramp_y)`` of
     the gradient magnitude (per world unit).
 
