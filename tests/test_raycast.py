@@ -255,8 +255,9 @@ def test_bit_identical_for_one_and_two_threads(filt, options):
     assert one.stats.samples == two.stats.samples
 
 
-@pytest.mark.parametrize("segment_ends", ["lattice", "exact"])
-@pytest.mark.parametrize("transfer", [Glow(3.0), TABLE], ids=["glow", "table"])
+@pytest.mark.parametrize(("transfer", "segment_ends"), [(Glow(3.0), "lattice"),
+                                                       (TABLE, "exact")],
+                         ids=["glow-lattice", "table-exact"])
 def test_small_renders_kernel_gives_the_packets_image(monkeypatch, transfer, segment_ends):
     """Below ``PACKET_SAMPLES`` a render takes the kernel without packets (compiled in less
     time), from it on the kernel with them: the same image bit for bit and the same samples
