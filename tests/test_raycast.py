@@ -1,6 +1,5 @@
 """Ray casting: agreement with the naive twin, determinism, skips, accuracy, bad input."""
 
-import inspect
 import math
 
 import naive
@@ -12,7 +11,6 @@ from naive import exact_blob_image, image_mass, random_orbits, raycast_naive
 import data_gen
 import vrlib
 from vrlib import Glow, LookupTransfer, Phong, View, Volume, metrics, render, render_reference
-from vrlib._kernels import raycast as raycast_kernel
 from vrlib._kernels._jit import borrowed
 from vrlib._kernels.queue import take
 from vrlib._scheduling import on_threads
@@ -253,32 +251,6 @@ def test_bit_identical_for_one_and_two_threads(filt, options):
     two = render(vol, view, filter=filt, threads=2, **options)
     assert np.array_equal(one.rgba, two.rgba)
     assert one.stats.samples == two.stats.samples
-
-
-@pytest.mark.parametrize(("transfer", "segment_ends"), [(Glow(3.0), "lattice"),
-                                                       (TABLE, "exact")],
-                         ids=["glow-lattice", "table-exact"])
-def test_small_renders_kernel_gives_the_packets_image(monkeypatch, transfer, segment_ends):
-    """Below ``PACKET_SAMPLES`` a render takes the kernel without packets (compiled in less
-    time), from it on the kernel with them: the same image bit for bit and the same samples
-    counted, grey or coloured, with the volume's faces cutting segments or not. A kernel of
-    small renders that lost the cut segments' lengths, or a packet that took a sample more
-    or less than the scalar loop, would differ."""
-    vol = data_gen.make_field("marschner-lobb").sample(24)
-    view = View.orbit(azimuth=20, elevation=35, size=70)
-    images = []
-    for threshold in (0, 1 << 62):  # every render with packets, then none
-        monkeypatch.setattr(vrlib.raycast, "PACKET_SAMPLES", threshold)
-        images.append(render(vol, view, transfer=transfer, segment_ends=segment_ends))
-    with_packets, without = images
-    assert np.array_equal(with_packets.rgba, without.rgba)
-    assert with_packets.stats.samples == without.stats.samples
-    assert with_packets.rgba[..., 3].max() > 0.5  # rays that take many samples
-    if not numba.config.DISABLE_JIT:  # both kernels were compiled, told apart by their kind
-        names = list(inspect.signature(raycast_kernel.raycast.py_func).parameters)
-        kinds = {(str(s[names.index("packets")]), str(s[names.index("small")]))
-                 for s in raycast_kernel.raycast.signatures}
-        assert {("bool", "none"), ("none", "bool")} <= kinds
 
 
 @pytest.mark.parametrize("filt", ["box", "trilinear", "catmull-rom", "gaussian"])

@@ -37,12 +37,6 @@ __all__ = ["render_raycast", "cast_rays", "segment_options", "operations_per_sam
 #: fetched (256^3 -> 512^2, 2 threads: 8 x 128 took 72 ms where 32 x 32 took 75).
 TILE = (8, 128)
 
-#: The fewest samples (bounded by the rays that can meet something times the box's diagonal
-#: over the step) for which a render takes the kernel with packets: below it the packets
-#: would save a few milliseconds, and compiling them adds about 0.9 s to a first render
-#: (:mod:`vrlib._kernels.packets`). Both kernels give the same image, bit for bit.
-PACKET_SAMPLES = 1 << 22
-
 
 def operations_per_sample(filt, *, shading=False):
     """Arithmetic operations for one ray sample, by this renderer's count.
@@ -313,21 +307,19 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
         # Colour equals opacity: white emission, no shading.
         grey = transfer.shading is None and bool(np.all(tables[4] == 1.0))
         filtering, lit, skipping, packets = plan.kind
-        small = None
-        if packets and plan.rays * (plan.diagonal / ds + 2.0) < PACKET_SAMPLES:
-            packets, small = None, True  # too few samples to repay compiling the packets
         # The tent filter unlit (a first render's kernel) is compiled without what a render
         # does not use: the colour of a grey table, the cut segments of lattice ends (None);
-        # the other kernels take them as flags, one kernel for both.
-        plain = filtering is None and lit is None
-        colour = None if grey and plain else True
-        exact = (True if exact_ends else None) if plain else bool(exact_ends)
+        # the other kernels take them as flags (False), one kernel for both.
+        if filtering is None and lit is None:
+            colour, exact = (None if grey else True), (True if exact_ends else None)
+        else:
+            colour, exact = not grey, bool(exact_ends)
         arguments = (*plan.layout, exact, view.packed(), view.height,
                      view.width, ds, *filt.code, filt.radius, filt.taps, *tables, *plan.lighting,
                      *plan.by_gradient, *skips,
                      readonly(vector(_NO_MULTIPLIER if multiplier is None else multiplier,
                                      np.int64)),
-                     *tiles, colour, filtering, lit, skipping, packets, small)
+                     *tiles, colour, filtering, lit, skipping, packets)
         on_threads(lambda i: _kernel.raycast(*arguments, plan.scratch[i],
                                              *(a[i] for a in plan.lanes)), plan.threads)
     return out, int(samples.sum())  # the kernels clip each pixel's opacity
@@ -359,12 +351,8 @@ class RayPlan(NamedTuple):
     lanes: tuple
     #: The kernel compiled for this kind of render (``filtering, lit, skipping, packets``):
     #: the tent filter, no shading or gradient opacity, a volume with nothing to skip, make a
-    #: smaller kernel, a shorter first wait (packets only for :data:`PACKET_SAMPLES` or more).
+    #: smaller kernel, a shorter first wait.
     kind: tuple
-    #: The rays that can meet something, and the length of the box's diagonal (world
-    #: units): how many samples a render can take at most, with the step.
-    rays: int
-    diagonal: float
 
 
 def _ray_plan(data, offset, global_shape, origin, spacing, box, view, filt, transfer, skip,
@@ -428,8 +416,7 @@ def _build_plan(data, offset, global_shape, origin, spacing, box, view, filt, tr
                    # threads' keeps them off each other's lines.
                    np.zeros((threads, 7, MAX_TAPS))[:, :6], _kernel.lanes(threads),
                    (filtering, lit, None if block == 0 else True,
-                    True if filtering is None and lit is None else None),
-                   int(costs.sum()), float(np.linalg.norm(np.subtract(box[1], box[0]))))
+                    True if filtering is None and lit is None else None))
 
 
 def _kept(memo, name, key, build):

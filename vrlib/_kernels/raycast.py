@@ -456,10 +456,6 @@ def _step_segment(front, back, length, start, inv, density, emission, grey):
             half_a * front_b + behind * back_b)
 
 
-#: :func:`_pixel_start`'s result for a ray that meets nothing.
-_NO_START = (False, (0.0, 0.0, 0.0), 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, -1, -1, 0.0, 0.0)
-
-
 @jit(inline="always")
 def _pixel_start(r, c, camera, height, width, mask, box_lo, box_hi, vol_lo, vol_hi, exact,
                  origin, inv, ds):
@@ -472,9 +468,11 @@ def _pixel_start(r, c, camera, height, width, mask, box_lo, box_hi, vol_lo, vol_
     faces cut at ``t_first`` and ``t_last`` (-1 without; a cut segment's sample may lie
     before segment ``k``'s, so ``k`` starts there)."""
     if r >= height or c >= width:
-        return _NO_START
+        return (False, (0.0, 0.0, 0.0), 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, -1, -1,
+                0.0, 0.0)
     if not mask[r, c]:  # a ray that meets nothing visible: no set-up at all
-        return _NO_START
+        return (False, (0.0, 0.0, 0.0), 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0, -1, -1,
+                0.0, 0.0)
     o, d = pixel_ray(camera, height, width, r, c)
     t_in, t_out = ray_box(o, d, box_lo, box_hi)
     t_in = max(t_in, 0.0)
@@ -497,16 +495,6 @@ def _pixel_start(r, c, camera, height, width, mask, box_lo, box_hi, vol_lo, vol_
             k -= 1
     hit = t_out > t_in
     return hit, d, t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, t_first, t_last
-
-
-@helper_jit
-def _pixel_start_apart(r, c, camera, height, width, mask, box_lo, box_hi, vol_lo, vol_hi,
-                       exact, origin, inv, ds):
-    """:func:`_pixel_start` compiled once, for the kernel of small renders to call: inlined,
-    it cost their first render 0.4 s of compile, while the call costs a ray some 30 ns (5%
-    of a dense 512^2 render, whose kernel inlines it)."""
-    return _pixel_start(r, c, camera, height, width, mask, box_lo, box_hi, vol_lo, vol_hi,
-                        exact, origin, inv, ds)
 
 
 @jit(inline="always")
@@ -608,8 +596,8 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
             tstart, tinv, alpha_tab, color_tab, emit_tab,
             shade, ka, kd, ks, shininess, light, headlight, ramp_x, ramp_y, by_gradient,
             threshold, empty, clearance, block, mask, bound, budget, multiplier, tile_h, tile_w,
-            order, counter, out, samples, colour, filtering, lighting, skipping, packets, small,
-            scratch, rays, steps, ray_state, ray_steps, status):
+            order, counter, out, samples, colour, filtering, lighting, skipping, packets, scratch,
+            rays, steps, ray_state, ray_steps, status):
     """Render ``out[row, col] = (r, g, b, a)`` premultiplied (``out`` comes transparent: a
     pixel whose ray meets nothing, and a tile left out of ``order``, stay so); count samples
     per tile.
@@ -639,26 +627,22 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
     Adaptive steps: where ``multiplier`` (per block of the skip grid, a power of two; a
     ``(1, 1, 1)`` array of 1 turns them off) exceeds 1, one sample stands for that many
     segments (:func:`_long_segment`, :mod:`vrlib.adaptive`).
-    ``colour`` None says the emission is 1 everywhere and unshaded, so colour equals
-    opacity (True: the colour comes from ``color_tab``, equal to the opacity table's for a
-    grey table, or the shading). ``by_gradient``
+    ``colour`` None or False says the emission is 1 everywhere and unshaded, so colour
+    equals opacity (True: the colour comes from ``color_tab`` or the shading; None compiles
+    the kernel without the colour, for the tent filter unshaded). ``by_gradient``
     multiplies the density by the piecewise-linear factor through ``(ramp_x, ramp_y)`` of
     the gradient magnitude (per world unit).
 
-    Compiled per kind of render: ``filtering`` None compiles only the tent filter,
-    ``lighting`` None only a table's colour (no shading, no gradient opacity), ``colour``
-    None no colour at all, and ``skipping`` None leaves out the skipping (``block = 0``).
-    numba drops a branch on a None argument before it types the function, so such a kernel
-    compiles in a fraction of the time (a first render's wait); ``True`` compiles that path.
-    ``packets`` True (for the tent filter without shading: ``filtering`` and ``lighting``
-    None) compiles the packets below, None leaves them out (a branch on ``True`` is typed
-    and compiled whether taken or not: only a None argument drops one). ``small`` is True
-    exactly when ``filtering``, ``lighting`` and ``packets`` are all None (the kernel of
-    small renders, :data:`vrlib.raycast.PACKET_SAMPLES`: it calls
-    :func:`_pixel_start_apart` where the others inline :func:`_pixel_start`), else None.
-    ``scratch`` (6 x ``MAX_TAPS``, this call's own) holds the filter's weights and their
-    derivatives along x, y and z; ``rays, steps, ray_state, ray_steps, status`` are this
-    call's lanes (:func:`lanes`).
+    Compiled per kind of render: ``filtering`` None compiles only the tent filter, ``lighting``
+    None only a table's colour (no shading, no gradient opacity), ``colour`` None no colour at
+    all, and ``skipping`` None leaves out the skipping (``block = 0``). numba drops a branch on
+    a None argument before it types the function, so such a kernel compiles in a fraction of
+    the time (a first render's wait); ``True`` compiles that path. ``packets`` True (for the
+    tent filter without shading: ``filtering`` and ``lighting`` None) compiles the packets
+    below, None leaves them out (a branch on ``True`` is typed and compiled whether taken or
+    not: only a None argument drops one). ``scratch`` (6 x ``MAX_TAPS``, this call's own) holds
+    the filter's weights and their derivatives along x, y and z; ``rays, steps, ray_state,
+    ray_steps, status`` are this call's lanes (:func:`lanes`).
 
     Rays go in groups of ``LANES`` pixels of a tile row. Each ray is marched alone (the
     checked samples: cut segments, borders, skips, other filters, shading) up to where its
@@ -707,17 +691,9 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                 c = col0 + (p0 + lane) % tile_w
                 if p0 + lane >= tile_h * tile_w:
                     continue
-                # Called in the kernel of small renders, inlined in the others (the two
-                # tests drop one branch or the other before typing: see below).
-                start = _NO_START
-                if small is not None:
-                    start = _pixel_start_apart(r, c, camera, height, width, mask, box_lo,
-                                               box_hi, vol_lo, vol_hi, exact, origin, inv, ds)
-                if packets is not None or filtering is not None or lighting is not None:
-                    start = _pixel_start(r, c, camera, height, width, mask, box_lo, box_hi,
-                                         vol_lo, vol_hi, exact, origin, inv, ds)
                 hit, d, t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, t_first, \
-                    t_last = start
+                    t_last = _pixel_start(r, c, camera, height, width, mask, box_lo, box_hi,
+                                          vol_lo, vol_hi, exact, origin, inv, ds)
                 if not hit:
                     continue
                 status[lane] = MARCH
@@ -831,7 +807,8 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                         alpha = entry(alpha_tab, i, w)
                         if not alpha > 0.0:
                             continue  # a transparent segment adds exactly nothing
-                        if colour is None and (lighting is None or not by_gradient):
+                        if ((colour is None or not colour)
+                                and (lighting is None or not by_gradient)):
                             cr = cg = cb = alpha  # white emission, no shading: colour = opacity
                         elif lighting is not None and (shade or by_gradient):
                             gx_, gy_, gz_ = gradient(data, offset, gshape, ux, uy, uz, fkind,
