@@ -314,8 +314,8 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
             colour, exact = (None if grey else True), (True if exact_ends else None)
         else:
             colour, exact = not grey, bool(exact_ends)
-        arguments = (*plan.layout, exact, view.packed(), view.height,
-                     view.width, ds, *filt.code, filt.radius, filt.taps, *tables, *plan.lighting,
+        arguments = (*plan.layout, exact, view.packed(), view.height, view.width, ds,
+                     *filt.code, filt.radius, filt.taps, *tables, *plan.lighting,
                      *plan.by_gradient, *skips,
                      readonly(vector(_NO_MULTIPLIER if multiplier is None else multiplier,
                                      np.int64)),
