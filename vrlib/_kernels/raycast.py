@@ -463,8 +463,8 @@ def _pixel_start(r, c, camera, height, width, mask, box_lo, box_hi, vol_lo, vol_
     ``(hit, d, t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, t_first, t_last)``.
     ``hit`` is False for a pixel outside the image or the ``mask``, or a ray that misses the
     box ``[box_lo, box_hi]``; ``d`` is the ray's direction, ``[t_in, t_out)`` its stretch in
-    the box, ``a + t b`` its index position, ``k`` the first segment; with ``exact`` True
-    (False or None: without), the segments ``k_first`` and ``k_last`` that the volume's
+    the box, ``a + t b`` its index position, ``k`` the first segment; with ``exact``, the
+    segments ``k_first`` and ``k_last`` that the volume's
     faces cut at ``t_first`` and ``t_last`` (-1 without; a cut segment's sample may lie
     before segment ``k``'s, so ``k`` starts there)."""
     if r >= height or c >= width:
@@ -486,7 +486,7 @@ def _pixel_start(r, c, camera, height, width, mask, box_lo, box_hi, vol_lo, vol_
     k = math.ceil(t_in / ds - 0.5) if t_out > t_in else 0
     k_first = k_last = -1
     t_first = t_last = 0.0
-    if exact is not None and exact and t_out > t_in:
+    if exact and t_out > t_in:
         t_first, t_last = ray_box(o, d, vol_lo, vol_hi)
         t_first = max(t_first, 0.0)
         k_first = math.floor(t_first / ds)
@@ -606,15 +606,14 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
     with ghost samples) of a volume of global shape ``gshape`` whose sample 0 is at world
     ``origin``; the rays of the packed view ``camera`` (one per pixel of a ``height x width``
     image) sample the world box ``[box_lo, box_hi]`` of a volume whose own box is
-    ``[vol_lo, vol_hi]`` (cut exactly at its faces when ``exact`` is True; None, not False,
-    compiles the kernel without the cuts). The image is cut into ``tile_h x tile_w`` pixel
-    tiles; a call takes the next tile of ``order`` (the heaviest first) from the shared queue
-    ``counter`` (:func:`vrlib._kernels.queue.take`) until none is left. Several threads make
-    the call at once (:func:`vrlib._scheduling.on_threads`; the kernel releases the GIL) and
-    finish together however unevenly the tiles cost; neighbouring rays read neighbouring
-    voxels, so a tile keeps them in cache. Each pixel is computed independently and in a fixed
-    order: the image depends neither on the number of threads nor on which thread took which
-    tile.
+    ``[vol_lo, vol_hi]`` (cut exactly at its faces when ``exact``). The image is cut into
+    ``tile_h x tile_w`` pixel tiles; a call takes the next tile of ``order`` (the heaviest
+    first) from the shared queue ``counter`` (:func:`vrlib._kernels.queue.take`) until none is
+    left. Several threads make the call at once (:func:`vrlib._scheduling.on_threads`; the
+    kernel releases the GIL) and finish together however unevenly the tiles cost; neighbouring
+    rays read neighbouring voxels, so a tile keeps them in cache. Each pixel is computed
+    independently and in a fixed order: the image depends neither on the number of threads nor
+    on which thread took which tile.
 
     Skips: ``empty`` flags blocks of ``block`` cells per axis that nothing visible can come
     from, and ``clearance`` (per block, an integer array of the same shape) how far a ray
@@ -734,7 +733,7 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                     while True:
                         t = (k + 0.5) * ds
                         fraction = 1.0
-                        if exact is not None and (k == k_first or k == k_last):
+                        if k == k_first or k == k_last:
                             t, fraction = _cut_segment(k, ds, t_first, t_last)
                             if t < t_in:  # another brick's sample
                                 k += 1
@@ -828,8 +827,7 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                             cr = entry_channel(color_tab, i, w, 0)
                             cg = entry_channel(color_tab, i, w, 1)
                             cb = entry_channel(color_tab, i, w, 2)
-                        # A segment cut by the volume's face, or a long one.
-                        if (exact is not None or skipping is not None) and fraction != 1.0:
+                        if fraction != 1.0:  # a segment cut by the volume's face, or a long one
                             part = _part_of_segment(alpha, fraction)
                             cr *= part / alpha
                             cg *= part / alpha
