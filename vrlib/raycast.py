@@ -294,19 +294,19 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
              readonly(vector(_NO_BOUND if bound is None else bound, np.float64)), float(budget))
     # The tiles, heaviest first, behind a queue that every thread takes the next one from.
     tiles = (*TILE, plan.order, np.zeros(1, np.int64), out, samples)
+    filtering, lit, skipping, packets = plan.kind
     if preintegrated:
         profile = "step" if filt.radius <= 0.5 else "linear"  # the box filter jumps
         arguments = (*plan.layout, view.packed(), view.height, view.width, ds, *filt.code,
                      filt.radius, filt.taps,
                      *transfer.preintegrated_table(ds, *value_range, profile=profile),
-                     *plan.lighting, *plan.by_gradient, *skips, *tiles)
+                     *plan.lighting, *plan.by_gradient, *skips, *tiles, filtering)
         on_threads(lambda i: _kernel.raycast_preintegrated(*arguments, plan.scratch[i]),
                    plan.threads)
     else:
         tables = transfer.segment_table(ds, *value_range)
         # Colour equals opacity: white emission, no shading.
         grey = transfer.shading is None and bool(np.all(tables[4] == 1.0))
-        filtering, lit, skipping, packets = plan.kind
         # The tent filter unlit (a first render's kernel) is compiled without the colour of
         # a grey table (None); the other kernels take it as a flag (False), one kernel for
         # both. The exact ends are a flag everywhere (None would drop their code, 0.25 s of

@@ -29,7 +29,6 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from numba import literally
 
 from vrlib._kernels._jit import borrowed, helper_jit, jit, trailing_zeros
 from vrlib._kernels.camera import pixel_ray, ray_box
@@ -314,22 +313,22 @@ def _skip(k, ux, uy, uz, ax, ay, az, bx, by, bz, ds, by_front, empty, clearance,
 
 
 @helper_jit
-def _preintegrated_ray(tent, data, flat, offset, gshape, inv, d, ax, ay, az, bx, by, bz, t_in,
-                       t_out, k, ds, k_first, k_last, t_first, t_last, fkind, fp0, fp1, fp2,
-                       radius, ntaps, start, vinv, density, psi, emission, step, grey,
-                       col_start, col_inv, mean, shade, ka, kd, ks, shininess, light,
-                       headlight, ramp_x, ramp_y, by_gradient, threshold, empty, clearance, block,
-                       fine_counts, bound, budget, wx, wy, wz, dx, dy, dz):
+def _preintegrated_ray(filtering, data, flat, offset, gshape, inv, d, ax, ay, az,
+                       bx, by, bz, t_in, t_out, k, ds, k_first, k_last, t_first, t_last,
+                       fkind, fp0, fp1, fp2, radius, ntaps, start, vinv, density, psi,
+                       emission, step, grey, col_start, col_inv, mean, shade, ka, kd, ks,
+                       shininess, light, headlight, ramp_x, ramp_y, by_gradient, threshold,
+                       empty, clearance, block, fine_counts, bound, budget, wx, wy, wz, dx,
+                       dy, dz):
     """One ray, pre-integrated: each segment ``[k ds, (k + 1) ds)`` (cut at the volume's
     faces) classified from its values at its two ends (the back of one is the front of the
     next), front to back from segment ``k`` while its middle lies before ``t_out``. Returns
-    ``(r, g, b, a, samples)``. ``tent`` (a compile-time constant: the loop is compiled once
-    for the tent filter, with no call in it, and once for the others, which call
-    :func:`_other_value`; a call in the loop, even one not taken, made the tent filter's
-    loop three times slower) says the filter is the tent; the other arguments are
-    :func:`raycast`'s (the table's named without ``pre_``), and ``wx ... dz`` scratch for
-    the filter's weights (:func:`~vrlib._kernels.sampling.tap_scratch`)."""
-    literally(tent)
+    ``(r, g, b, a, samples)``. ``filtering`` is None for the tent filter, as in
+    :func:`raycast`: numba drops the other filters' code before typing, so the tent filter's
+    loop holds no call (a call in the loop, even one not taken, made it three times slower).
+    The other arguments are :func:`raycast`'s (the table's named without ``pre_``), and
+    ``wx ... dz`` scratch for the filter's weights
+    (:func:`~vrlib._kernels.sampling.tap_scratch`)."""
     nx = data.shape[2]
     nxy = data.shape[1] * data.shape[2]
     oz, oy, ox = offset[0], offset[1], offset[2]
@@ -368,7 +367,7 @@ def _preintegrated_ray(tent, data, flat, offset, gshape, inv, d, ax, ay, az, bx,
                 k = k_next
                 continue
         if k != k_front:
-            if tent:
+            if filtering is None:
                 front = trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ax + t_a * bx,
                                   ay + t_a * by, az + t_a * bz)
             else:
@@ -377,7 +376,7 @@ def _preintegrated_ray(tent, data, flat, offset, gshape, inv, d, ax, ay, az, bx,
                                      fkind, fp0, fp1, fp2, radius, ntaps, wx, wy, wz)
             psi_front = psi_at(front, start, vinv, density, psi)
             taken += 1
-        if tent:
+        if filtering is None:
             back = trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ax + t_b * bx,
                              ay + t_b * by, az + t_b * bz)
         else:
@@ -531,7 +530,7 @@ def raycast_preintegrated(data, offset, gshape, origin, spacing, box_lo, box_hi,
                           pre_step, pre_grey, col_start, col_inv, pre_mean, shade, ka, kd, ks,
                           shininess, light, headlight, ramp_x, ramp_y, by_gradient, threshold,
                           empty, clearance, block, mask, bound, budget, tile_h, tile_w, order,
-                          counter, out, samples, scratch):
+                          counter, out, samples, filtering, scratch):
     """:func:`raycast` with pre-integrated classification (a kernel of its own, so that a
     render compiles only the loop it runs): each segment is classified from its values at
     its two ends (:func:`_preintegrated_ray`), always cut at the volume's faces. The
@@ -541,7 +540,8 @@ def raycast_preintegrated(data, offset, gshape, origin, spacing, box_lo, box_hi,
     col_inv``) unless ``pre_grey``; with ``pre_step`` (the box filter) half a segment at
     each end's value, ``pre_emission`` on the density's grid
     (:class:`vrlib.transfer.PreintegratedTable`). The other arguments are as for
-    :func:`raycast`."""
+    :func:`raycast` (``filtering`` its kind: None for the tent filter drops the others'
+    code)."""
     data, offset, gshape, origin, camera, light, ramp_x, ramp_y, empty, clearance, bound, \
         flat, inv, fine_counts, wx, wy, wz, dx, dy, dz = _loop_views(
             data, offset, gshape, origin, spacing, camera, light, ramp_x, ramp_y, empty,
@@ -567,23 +567,13 @@ def raycast_preintegrated(data, offset, gshape, origin, spacing, box_lo, box_hi,
                              vol_hi, True, origin, inv, ds)
             if not hit:
                 continue
-            # One compiled loop per reconstruction: the tent filter's holds no call.
-            if fkind == TENT:
-                rgba = _preintegrated_ray(
-                    True, data, flat, offset, gshape, inv, d, ax, ay, az, bx, by, bz, t_in, t_out,
-                    k, ds, k_first, k_last, t_first, t_last, fkind, fp0, fp1, fp2, radius, ntaps,
-                    pre_start, pre_inv, pre_density, pre_psi, pre_emission, pre_step, pre_grey,
-                    col_start, col_inv, pre_mean, shade, ka, kd, ks, shininess, light, headlight,
-                    ramp_x, ramp_y, by_gradient, threshold, empty, clearance, block, fine_counts,
-                    bound, budget, wx, wy, wz, dx, dy, dz)
-            else:
-                rgba = _preintegrated_ray(
-                    False, data, flat, offset, gshape, inv, d, ax, ay, az, bx, by, bz, t_in, t_out,
-                    k, ds, k_first, k_last, t_first, t_last, fkind, fp0, fp1, fp2, radius, ntaps,
-                    pre_start, pre_inv, pre_density, pre_psi, pre_emission, pre_step, pre_grey,
-                    col_start, col_inv, pre_mean, shade, ka, kd, ks, shininess, light, headlight,
-                    ramp_x, ramp_y, by_gradient, threshold, empty, clearance, block, fine_counts,
-                    bound, budget, wx, wy, wz, dx, dy, dz)
+            rgba = _preintegrated_ray(
+                filtering, data, flat, offset, gshape, inv, d, ax, ay, az, bx, by, bz, t_in,
+                t_out, k, ds, k_first, k_last, t_first, t_last, fkind, fp0, fp1, fp2, radius,
+                ntaps, pre_start, pre_inv, pre_density, pre_psi, pre_emission, pre_step,
+                pre_grey, col_start, col_inv, pre_mean, shade, ka, kd, ks, shininess, light,
+                headlight, ramp_x, ramp_y, by_gradient, threshold, empty, clearance, block,
+                fine_counts, bound, budget, wx, wy, wz, dx, dy, dz)
             _put_pixel(out, r, c, rgba[0], rgba[1], rgba[2], rgba[3])
             taken += rgba[4]
         samples[tile_id] = taken
