@@ -167,30 +167,35 @@ class Filter:
 # -- piecewise polynomials: box, tent and the cubics ---------------------------------------
 
 
-def _cos_moment(n, a, b, omega):
-    """``int_a^b x^n cos(omega x) dx`` for ``0 <= a < b``, stable for every ``omega``."""
+def _cos_integral(coeffs, a, b, omega):
+    """``int_a^b p(x) cos(omega x) dx`` for the polynomial ``p`` of ``coeffs`` (ascending
+    powers) and ``0 <= a < b``, stable for every ``omega``."""
     omega = np.abs(np.asarray(omega, dtype=np.float64))
     out = np.empty_like(omega)
     small = omega * b < 2.0
-    # Near zero: the Taylor series of the cosine, integrated term by term.
-    w = omega[small]
-    acc = np.zeros_like(w)
+    # Near zero: the Taylor series of the cosine, integrated term by term against p.
+    w2 = omega[small] ** 2
+    acc = np.zeros_like(w2)
+    term = np.ones_like(w2)
     for m in range(40):
-        p = n + 2 * m + 1
-        acc += (-1.0) ** m * w ** (2 * m) / math.factorial(2 * m) * (b**p - a**p) / p
+        moment = sum(c * (b ** (n + 2 * m + 1) - a ** (n + 2 * m + 1)) / (n + 2 * m + 1)
+                     for n, c in enumerate(coeffs))
+        acc += term * moment
+        term *= -w2 / ((2 * m + 1) * (2 * m + 2))
     out[small] = acc
-    # Elsewhere: the antiderivative Re[exp(i w x) sum_k (-1)^k n!/(n-k)! x^(n-k) / (i w)^(k+1)].
-    w = omega[~small]
-
-    def antiderivative(x):
-        total = np.zeros(w.shape, dtype=np.complex128)
-        for k in range(n + 1):
-            total += (-1) ** k * math.factorial(n) / math.factorial(n - k) * x ** (n - k) / (
-                1j * w
-            ) ** (k + 1)
-        return (np.exp(1j * w * x) * total).real
-
-    out[~small] = antiderivative(b) - antiderivative(a)
+    # Elsewhere, by parts: int p(x) exp(i w x) dx = exp(i w x) sum_k (-1)^k p^(k)(x) / (i w)^(k+1).
+    iw = 1j * omega[~small]
+    total = np.zeros(iw.shape)
+    for x, sign in ((b, 1.0), (a, -1.0)):
+        series = np.zeros(iw.shape, dtype=np.complex128)
+        power = 1.0 / iw
+        derivative = np.asarray(coeffs, dtype=np.float64)
+        for k in range(len(coeffs)):
+            series += (-1) ** k * np.polynomial.polynomial.polyval(x, derivative) * power
+            derivative = np.polynomial.polynomial.polyder(derivative)
+            power = power / iw
+        total += sign * (np.exp(iw * x) * series).real
+    out[~small] = total
     return out
 
 
@@ -233,9 +238,7 @@ class _Piecewise(Filter):
         omega = np.asarray(omega, dtype=np.float64)
         total = np.zeros(omega.shape)
         for a, b, coeffs in self.pieces:
-            for n, c in enumerate(coeffs):
-                if c != 0.0:
-                    total = total + c * _cos_moment(n, a, b, omega)
+            total = total + _cos_integral(coeffs, a, b, omega)
         return 2.0 * total
 
 
