@@ -156,12 +156,16 @@ def test_every_message_is_bounded_by_the_simulated_one():
 
 
 @pytest.mark.mpi
+@pytest.mark.slow
 def test_ranks_read_their_bricks_from_a_file(tmp_path):
     """Five ranks read their bricks (and ghosts) of a non-cubic .npy file through memory maps:
     radix-k (5, one round), the work-sized split, interleaved bricks and the image partition
     all equal the serial render of the file as data_gen.load reads it. (float64 samples: the
     ranks load the kernels the session compiled; NIfTI, raw and float32 bricks are checked
-    in process above, since five ranks compiling new kernels at once take half a minute.)"""
+    in process below, since five ranks compiling new kernels at once take half a minute.
+    ``make test-all`` only: five ranks starting on two cores took 9 to 11 s of ``make
+    test``'s 5 minutes, and ``make test`` checks files read brick by brick in process and
+    ranks compositing bricks on 3 ranks.)"""
     data = data_gen.make_field("marschner-lobb").sample((21, 25, 29)).data
     source = write_volume_files(tmp_path, data)[0][0]
     views = [({"azimuth": 35, "elevation": 25}, "catmull-rom")]
