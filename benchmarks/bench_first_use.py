@@ -1,9 +1,9 @@
 """The wait on first use (``make bench``): ``vrlib render`` in a fresh process with an empty
 numba cache, as on a new machine, for the renders a new user starts with (an analytic field,
-a scanner's file with the automatic transfer function, shading, a cubic filter, splatting),
-beside the same command once the cache holds the kernels (one run each: a cold run takes up
-to 20 s). The table gives the render as the command line reports it and the whole command
-(Python's start and imports included).
+a scanner's file with the automatic transfer function, shading, a cubic filter, splatting,
+pre-integrated classification), beside the same command once the cache holds the kernels (one
+run each: a cold run takes up to 20 s). The table gives the render as the command line reports
+it and the whole command (Python's start and imports included).
 """
 
 from __future__ import annotations
@@ -29,6 +29,7 @@ CASES = [
     ("field, shaded", ["gaussian-blob:32", "--shade"]),
     ("field, Catmull-Rom", ["gaussian-blob:32", "--filter", "catmull-rom"]),
     ("field, splatting", ["gaussian-blob:32", "--method", "splat"]),
+    ("field, pre-integrated", ["gaussian-blob:32", "--option", "classification=preintegrated"]),
 ]
 
 
