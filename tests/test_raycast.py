@@ -11,7 +11,8 @@ from naive import exact_blob_image, image_mass, random_orbits, raycast_naive
 import data_gen
 import vrlib
 from vrlib import Glow, LookupTransfer, Phong, View, Volume, metrics, render, render_reference
-from vrlib._kernels._jit import borrowed
+from vrlib._kernels import sampling
+from vrlib._kernels._jit import borrowed, readonly
 from vrlib._kernels.queue import take
 from vrlib._scheduling import on_threads
 from vrlib.parallel.sources import ghost as ghost_samples
@@ -236,6 +237,46 @@ def test_a_borrowed_view_reads_the_same_array():
     """``borrowed`` drops only the reference count: the same data, shape and values."""
     values = np.arange(10.0)
     assert _borrowed_sum(values) == (45.0, 10)
+
+
+@numba.njit(cache=True)
+def _tent_and_general_gradients(data, offset, gshape, points, code, scratch):
+    out = np.empty((points.shape[0], 2, 3))
+    wx, wy, wz, dx, dy, dz = scratch[0], scratch[1], scratch[2], scratch[3], scratch[4], \
+        scratch[5]
+    for i in range(points.shape[0]):
+        ux, uy, uz = points[i, 0], points[i, 1], points[i, 2]
+        out[i, 0, 0], out[i, 0, 1], out[i, 0, 2] = sampling.tent_gradient(data, offset, gshape,
+                                                                          ux, uy, uz)
+        out[i, 1, 0], out[i, 1, 1], out[i, 1, 2] = sampling.gradient(
+            data, offset, gshape, ux, uy, uz, code[0], code[1], code[2], code[3], 1.0, 2, wx,
+            wy, wz, dx, dy, dz)
+    return out
+
+
+def test_the_tent_gradient_is_the_general_gradient_bit_for_bit():
+    """The shaded tent kernels take ``tent_gradient``, the general gradient's sums written
+    out for two taps a side: the same numbers bit for bit at random points, on the lattice
+    (where the tent's slope jumps), on and beyond the volume's faces (clamped taps), in a
+    brick whose samples start past global index 0."""
+    rng = np.random.default_rng(11)
+    gshape = np.array([9, 10, 11])
+    whole = rng.normal(size=tuple(gshape))
+    offset = np.array([2, 3, 0])
+    brick = readonly(np.ascontiguousarray(whole[2:, 3:, :]))
+    top = gshape[::-1] - 1.0  # (x, y, z) of the last sample
+    first = offset[::-1].astype(float)  # (x, y, z) of the brick's first sample
+    inside = first + rng.uniform(0.0, 1.0, (300, 3)) * (top - first)
+    lattice = np.round(inside[:60])
+    faces = inside[:60].copy()
+    faces[:20, 0], faces[20:40, 1], faces[40:, 2] = top[0], top[1], top[2]
+    beyond = inside[:60] + [1.5, 0.7, 2.2]
+    points = np.concatenate([inside, lattice, faces, beyond])
+    code = np.array(vrlib.make_filter("trilinear").code, dtype=np.float64)
+    both = _tent_and_general_gradients(brick, offset, gshape, points, code,
+                                       np.zeros((6, 8)))
+    np.testing.assert_array_equal(both[:, 0], both[:, 1])
+    assert np.abs(both[:, 0]).max() > 0.5 and (both[:, 0] == 0.0).any()
 
 
 @pytest.mark.parametrize("options", [{}, {"segment_ends": "exact"},

@@ -56,6 +56,7 @@ from vrlib._kernels.sampling import (
     gradient,
     reconstruct,
     separable4,
+    tent_gradient,
     tricubic,
     trilinear,
 )
@@ -416,8 +417,11 @@ def _preintegrated_ray(filtering, data, flat, offset, gshape, inv, d, ax, ay, az
         if shade or by_gradient:
             # The gradient at the segment's middle modulates the segment.
             ux, uy, uz = ax + t * bx, ay + t * by, az + t * bz
-            gx_, gy_, gz_ = gradient(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1, fp2,
-                                     radius, ntaps, wx, wy, wz, dx, dy, dz)
+            if filtering is None:
+                gx_, gy_, gz_ = tent_gradient(data, offset, gshape, ux, uy, uz)
+            else:
+                gx_, gy_, gz_ = gradient(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1,
+                                         fp2, radius, ntaps, wx, wy, wz, dx, dy, dz)
             if headlight:
                 lx, ly, lz = -d[0], -d[1], -d[2]
             else:
@@ -800,9 +804,12 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                                 and (lighting is None or not by_gradient)):
                             cr = cg = cb = alpha  # white emission, no shading: colour = opacity
                         elif lighting is not None and (shade or by_gradient):
-                            gx_, gy_, gz_ = gradient(data, offset, gshape, ux, uy, uz, fkind,
-                                                     fp0, fp1, fp2, radius, ntaps, wx, wy, wz,
-                                                     dx, dy, dz)
+                            if filtering is None:
+                                gx_, gy_, gz_ = tent_gradient(data, offset, gshape, ux, uy, uz)
+                            else:
+                                gx_, gy_, gz_ = gradient(data, offset, gshape, ux, uy, uz,
+                                                         fkind, fp0, fp1, fp2, radius, ntaps,
+                                                         wx, wy, wz, dx, dy, dz)
                             if headlight:
                                 lx, ly, lz = -d[0], -d[1], -d[2]
                             else:
