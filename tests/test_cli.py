@@ -72,6 +72,29 @@ def test_render_npy_matches_the_python_api(tmp_path):
     np.testing.assert_array_equal(np.load(out), expected.rgba)
 
 
+def test_a_switch_option_takes_true_and_false(tmp_path):
+    """``--option NAME=false`` (or ``true``, any case) gives the option a boolean, as the
+    Python API takes it (the words were passed on as strings and refused); a word that is
+    neither is still refused, by name."""
+    import data_gen
+    import vrlib
+
+    vol = data_gen.make_field("gaussian-blob").sample(12)
+    view = vrlib.View.orbit(azimuth=10, elevation=5, size=16, radius=vol.bounding_radius,
+                            center=vol.center)
+    for word in ("false", "False", "TRUE"):
+        out = tmp_path / f"{word}.npy"
+        done = run("render", "gaussian-blob:12", "--size", "16", "--azimuth", "10",
+                   "--elevation", "5", "--option", f"empty_space_skipping={word}", "-o",
+                   str(out))
+        assert done.returncode == 0, done.stderr
+        expected = vrlib.render(vol, view, empty_space_skipping=word.lower() == "true")
+        np.testing.assert_array_equal(np.load(out), expected.rgba)
+    done = run("render", "gaussian-blob:12", "--size", "16", "--option",
+               "empty_space_skipping=no", "-o", str(tmp_path / "no.npy"))
+    assert done.returncode == 2 and "empty_space_skipping must be True or False" in done.stderr
+
+
 def test_render_to_a_tolerance_matches_the_python_api(tmp_path):
     """--tolerance renders as render(..., tolerance=) does and says what it chose."""
     import data_gen

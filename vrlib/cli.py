@@ -673,7 +673,8 @@ def _add_method(parser):
                              "(maximum intensity) or mean value along each ray (ray casting)")
     parser.add_argument("--option", action="append", default=[], metavar="NAME=VALUE",
                         help="a method's own option, e.g. --option mode=direct (splat), "
-                             "--option segment_ends=exact (raycast); repeat for more")
+                             "--option segment_ends=exact (raycast), --option "
+                             "empty_space_skipping=false; repeat for more")
 
 
 def _method_options(args):
@@ -683,7 +684,9 @@ def _method_options(args):
         name, equals, value = text.partition("=")
         if not equals or not name.strip():
             raise UsageError(f"--option must be NAME=VALUE, got {text!r}")
-        options[name.strip().replace("-", "_")] = _number(value.strip())
+        value = value.strip()
+        truth = {"true": True, "false": False}.get(value.lower())  # a switch: --option x=false
+        options[name.strip().replace("-", "_")] = _number(value) if truth is None else truth
     return (args.method or "raycast", args.blend or "emission-absorption", options)
 
 
