@@ -54,12 +54,27 @@ def cubic_piece_slope(p, x):
     return 3.0 * p[3] * x * x + 2.0 * p[2] * x + p[1]
 
 
+@helper_jit
+def tent_weight(x):
+    """The tent filter's weight at offset ``x``: :func:`weight` for ``TENT`` alone, which a
+    tent kernel calls without compiling the other filters' branches."""
+    ax = abs(x)
+    return 1.0 - ax if ax < 1.0 else 0.0
+
+
+@helper_jit
+def tent_derivative(x):
+    """:func:`derivative` for ``TENT`` alone, as :func:`tent_weight`."""
+    if x == 0.0 or abs(x) >= 1.0:
+        return 0.0
+    return -1.0 if x > 0.0 else 1.0
+
+
 @jit
 def weight(kind, p0, p1, p2, x):
     """Filter weight at offset ``x`` (voxels) from a sample."""
     if kind == TENT:
-        ax = abs(x)
-        return 1.0 - ax if ax < 1.0 else 0.0
+        return tent_weight(x)
     if kind == CUBIC:
         near, far = cubic_coefficients(p0, p1, p2)
         ax = abs(x)
@@ -80,9 +95,7 @@ def weight(kind, p0, p1, p2, x):
 def derivative(kind, p0, p1, p2, x):
     """Derivative of :func:`weight` with respect to ``x`` (zero where it is undefined)."""
     if kind == TENT:
-        if x == 0.0 or abs(x) >= 1.0:
-            return 0.0
-        return -1.0 if x > 0.0 else 1.0
+        return tent_derivative(x)
     if kind == CUBIC:
         near, far = cubic_coefficients(p0, p1, p2)
         ax = abs(x)

@@ -18,10 +18,11 @@ from vrlib._kernels.filters import (
     BOX,
     GAUSSIAN,
     MAX_TAPS,
-    TENT,
     cubic_coefficients,
     cubic_piece,
     derivative,
+    tent_derivative,
+    tent_weight,
     weight,
 )
 
@@ -263,15 +264,12 @@ def tent_gradient(data, offset, gshape, ux, uy, uz):
     fx = int(math.floor(ux - 1.0)) + 1
     fy = int(math.floor(uy - 1.0)) + 1
     fz = int(math.floor(uz - 1.0)) + 1
-    wx0, wx1 = weight(TENT, 0.0, 0.0, 0.0, ux - fx), weight(TENT, 0.0, 0.0, 0.0, ux - (fx + 1))
-    wy0, wy1 = weight(TENT, 0.0, 0.0, 0.0, uy - fy), weight(TENT, 0.0, 0.0, 0.0, uy - (fy + 1))
-    wz0, wz1 = weight(TENT, 0.0, 0.0, 0.0, uz - fz), weight(TENT, 0.0, 0.0, 0.0, uz - (fz + 1))
-    dx0 = derivative(TENT, 0.0, 0.0, 0.0, ux - fx)
-    dx1 = derivative(TENT, 0.0, 0.0, 0.0, ux - (fx + 1))
-    dy0 = derivative(TENT, 0.0, 0.0, 0.0, uy - fy)
-    dy1 = derivative(TENT, 0.0, 0.0, 0.0, uy - (fy + 1))
-    dz0 = derivative(TENT, 0.0, 0.0, 0.0, uz - fz)
-    dz1 = derivative(TENT, 0.0, 0.0, 0.0, uz - (fz + 1))
+    wx0, wx1 = tent_weight(ux - fx), tent_weight(ux - (fx + 1))
+    wy0, wy1 = tent_weight(uy - fy), tent_weight(uy - (fy + 1))
+    wz0, wz1 = tent_weight(uz - fz), tent_weight(uz - (fz + 1))
+    dx0, dx1 = tent_derivative(ux - fx), tent_derivative(ux - (fx + 1))
+    dy0, dy1 = tent_derivative(uy - fy), tent_derivative(uy - (fy + 1))
+    dz0, dz1 = tent_derivative(uz - fz), tent_derivative(uz - (fz + 1))
     x0 = clamp(fx, gshape[2]) - offset[2]
     x1 = clamp(fx + 1, gshape[2]) - offset[2]
     gx = 0.0
