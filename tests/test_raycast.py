@@ -1,5 +1,6 @@
 """Ray casting: agreement with the naive twin, determinism, skips, accuracy, bad input."""
 
+import inspect
 import math
 
 import naive
@@ -11,6 +12,7 @@ from naive import exact_blob_image, image_mass, random_orbits, raycast_naive
 import data_gen
 import vrlib
 from vrlib import Glow, LookupTransfer, Phong, View, Volume, metrics, render, render_reference
+from vrlib._kernels import raycast as raycast_kernel
 from vrlib._kernels import sampling
 from vrlib._kernels._jit import borrowed, readonly
 from vrlib._kernels.queue import take
@@ -277,6 +279,104 @@ def test_the_tent_gradient_is_the_general_gradient_bit_for_bit():
                                        np.zeros((6, 8)))
     np.testing.assert_array_equal(both[:, 0], both[:, 1])
     assert np.abs(both[:, 0]).max() > 0.5 and (both[:, 0] == 0.0).any()
+
+
+@pytest.mark.parametrize(("transfer", "segment_ends"), [(Glow(3.0), "lattice"),
+                                                       (TABLE, "exact")],
+                         ids=["glow-lattice", "table-exact"])
+def test_a_quick_start_gives_the_packets_image(monkeypatch, transfer, segment_ends):
+    """A quick start (a one-off render of few samples inside
+    :func:`vrlib.raycast.quick_starts`, while the kernel with packets is not compiled) takes
+    the kernel without packets, then, once it is compiled, the one with them: the same image
+    bit for bit and the same samples counted, grey or coloured, with the volume's faces
+    cutting segments or not. A kernel without packets that lost the cut segments' lengths,
+    or a packet that took a sample more or less than the scalar loop, would differ; so would
+    a quick start that took the packets after all (the kernels' signatures tell them
+    apart)."""
+    vol = data_gen.make_field("marschner-lobb").sample(24)
+    view = View.orbit(azimuth=20, elevation=35, size=70)
+    monkeypatch.setenv("VRLIB_QUICK_START", "1")
+    monkeypatch.setattr(vrlib.raycast, "_quick_start", {"on": 0, "ready": set()})
+    images = []
+    for compiled in (False, True):  # the packets' kernel not compiled, then compiled
+        monkeypatch.setattr(vrlib.raycast, "compiled_or_cached", lambda d, a, c=compiled: c)
+        with vrlib.raycast.quick_starts():
+            images.append(render(vol, view, transfer=transfer, segment_ends=segment_ends))
+    quick, with_packets = images
+    assert np.array_equal(quick.rgba, with_packets.rgba)
+    assert quick.stats.samples == with_packets.stats.samples
+    assert quick.rgba[..., 3].max() > 0.5  # rays that take many samples
+    if not numba.config.DISABLE_JIT:  # both kernels were compiled, told apart by `packets`
+        names = list(inspect.signature(raycast_kernel.raycast.py_func).parameters)
+        kinds = {str(s[names.index("packets")]) for s in raycast_kernel.raycast.signatures}
+        assert {"bool", "none"} <= kinds
+
+
+def test_quick_starts_only_where_asked(monkeypatch, tmp_path):
+    """A render asks whether the kernel with packets is ready (and takes the quick start if
+    not) only inside :func:`vrlib.raycast.quick_starts`, for one render (not the renders of
+    a tolerance's pilots, which share a memo), of few samples, unless
+    ``VRLIB_QUICK_START=0``; a yes is kept. ``vrlib render`` renders inside it."""
+    vol = data_gen.make_field("gaussian-blob").sample(12)
+    view = View.orbit(size=16)
+    asked = []
+    monkeypatch.setenv("VRLIB_QUICK_START", "1")
+    state = {"on": 0, "ready": set()}
+    monkeypatch.setattr(vrlib.raycast, "_quick_start", state)
+    answer = [False]
+    monkeypatch.setattr(vrlib.raycast, "compiled_or_cached",
+                        lambda d, a: asked.append(a[-7] is True) or answer[0])
+    render(vol, view)
+    assert asked == []  # outside quick_starts()
+    with vrlib.raycast.quick_starts():
+        render(vol, view)
+        assert asked == [True] and not state["ready"]  # asked about the packets' kernel
+        render(vol, view, tolerance=1e-2)  # pilots and the render share a memo
+        assert len(asked) == 1
+        monkeypatch.setattr(vrlib.raycast, "QUICK_START_SAMPLES", 1)
+        render(vol, view)
+        assert len(asked) == 1  # many samples
+        monkeypatch.setattr(vrlib.raycast, "QUICK_START_SAMPLES", 1 << 22)
+        monkeypatch.setenv("VRLIB_QUICK_START", "0")
+        render(vol, view)
+        assert len(asked) == 1  # turned off
+        monkeypatch.setenv("VRLIB_QUICK_START", "1")
+        answer[0] = True
+        render(vol, view)
+        render(vol, view)
+        assert len(asked) == 2 and len(state["ready"]) == 1  # ready, and kept
+    assert state["on"] == 0
+    from vrlib import cli
+
+    state["ready"].clear()
+    out = tmp_path / "blob.npy"
+    assert cli.main(["render", "gaussian-blob:12", "--size", "16", "-o", str(out)]) == 0
+    assert len(asked) == 3 and out.exists() and state["on"] == 0
+
+
+def test_compiled_or_cached_loads_without_compiling(tmp_path):
+    """:func:`vrlib._kernels._jit.compiled_or_cached` answers from this process's compiled
+    signatures and numba's disk cache, and never compiles: False for a signature neither
+    holds, True once compiled, and True for a new dispatcher of the same function whose
+    signature only the disk holds, which it then runs without compiling."""
+    if numba.config.DISABLE_JIT:
+        pytest.skip("no dispatchers without the JIT")
+    import importlib.util
+
+    from vrlib._kernels._jit import compiled_or_cached
+
+    # A function in a file of this test's own: numba's cache of it starts empty.
+    (tmp_path / "doubling.py").write_text("def twice(x):\n    return 2 * x\n")
+    spec = importlib.util.spec_from_file_location("doubling", tmp_path / "doubling.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    first = numba.njit(cache=True)(module.twice)
+    assert not compiled_or_cached(first, (1.5,)) and not first.overloads
+    assert first(1.5) == 3.0 and compiled_or_cached(first, (1.5,))
+    assert not compiled_or_cached(first, (1,))  # another signature
+    second = numba.njit(cache=True)(module.twice)
+    assert compiled_or_cached(second, (1.5,)) and len(second.overloads) == 1
+    assert second(1.5) == 3.0 and second.stats.cache_misses == {}
 
 
 @pytest.mark.parametrize("options", [{}, {"segment_ends": "exact"},

@@ -10,7 +10,9 @@ ray termination stops a ray once its opacity reaches a threshold (the image chan
 
 from __future__ import annotations
 
+import contextlib
 import functools
+import os
 import time
 from typing import NamedTuple
 
@@ -19,7 +21,7 @@ import numpy as np
 
 from vrlib import validate
 from vrlib._kernels import raycast as _kernel
-from vrlib._kernels._jit import readonly
+from vrlib._kernels._jit import compiled_or_cached, readonly
 from vrlib._kernels.filters import MAX_TAPS, TENT
 from vrlib._scheduling import on_threads
 from vrlib.adaptive import step_multipliers
@@ -29,13 +31,40 @@ from vrlib.skipping import BLOCK, footprint_mask, skip_grid, visible_box
 from vrlib.value_bounds import reconstructed_range
 from vrlib.volume import lattice_extent
 
-__all__ = ["render_raycast", "cast_rays", "segment_options", "operations_per_sample",
-           "skip_bounds", "brightest"]
+__all__ = ["render_raycast", "cast_rays", "quick_starts", "segment_options",
+           "operations_per_sample", "skip_bounds", "brightest"]
 
 #: Pixels (rows, columns) of the image tiles that the threads take from the queue. Packets
 #: go along a tile's rows: wide tiles keep the next packets on the lines the last ones
 #: fetched (256^3 -> 512^2, 2 threads: 8 x 128 took 72 ms where 32 x 32 took 75).
 TILE = (8, 128)
+
+#: A quick start (the command line's render, :func:`quick_starts`): a one-off render of
+#: fewer samples than this (bounded by the rays that can meet something times the box's
+#: diagonal over the step) takes the kernel without packets while the one with them is
+#: neither compiled nor in numba's cache. That kernel compiles in about three quarters of
+#: the time (the packets and their hand-over are a quarter of a first compile) and gives the
+#: same image bit for bit; on so few samples the packets would save milliseconds.
+QUICK_START_SAMPLES = 1 << 22
+
+#: Where quick starts are on (:func:`quick_starts`), and the kinds of render whose kernel
+#: with packets is known to be ready.
+_quick_start = {"on": 0, "ready": set()}
+
+
+@contextlib.contextmanager
+def quick_starts():
+    """Quick starts for the renders inside: ``vrlib render``'s one render, where a first
+    use's wait is all of a user's wait. A Python session keeps its renders on the kernel
+    with packets from the first (it compiles it on first use, a second longer): its later
+    renders, and any timing of them, are then the fastest. ``VRLIB_QUICK_START=0`` in the
+    environment turns quick starts off everywhere (the test suite's setting: a kernel
+    compiled once, not twice)."""
+    _quick_start["on"] += 1
+    try:
+        yield
+    finally:
+        _quick_start["on"] -= 1
 
 
 def operations_per_sample(filt, *, shading=False):
@@ -123,7 +152,7 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
     start = time.perf_counter()
     tally = Tally()
     volume = prepared(volume, filt, tally)  # prefiltered filters: the 3-D coefficients
-    memo = {} if memo is None else memo
+    one_off, memo = memo is None, {} if memo is None else memo
     kept = functools.partial(_kept, memo)
     extent = volume.extent
     box_lo, box_hi = kept("box", (volume,), lambda: (extent[:, 0].copy(), extent[:, 1].copy()))
@@ -162,7 +191,7 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
         ds=ds, value_range=value_range,
         early_termination=early_termination, skip=skip, exact_ends=exact,
         preintegrated=preint, bound=bound, budget=skip_budget, multiplier=multiplier,
-        memo=memo)
+        memo=memo, quick_start=one_off)
     stats = RenderStats(
         samples=taken,
         operations=taken * operations_per_sample(filt, shading=transfer.needs_gradient),
@@ -242,7 +271,8 @@ def brightest(transfer, value_range):
 
 def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, transfer, ds,
               value_range, early_termination, skip=None, exact_ends=False,
-              preintegrated=False, bound=None, budget=0.0, multiplier=None, memo=None):
+              preintegrated=False, bound=None, budget=0.0, multiplier=None, memo=None,
+              quick_start=False):
     """Ray-cast samples ``data`` (all of a volume, or a brick of it with ghost samples): the
     ray caster's core, which the MPI renderers run on each brick or tile.
 
@@ -278,6 +308,10 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
     memo : dict or None
         Keeps what does not depend on the step (:class:`RayPlan`) between calls that give
         the same objects for all else: renders of one scene at several steps.
+    quick_start : bool
+        A one-off render, which inside :func:`quick_starts` takes the kernel without packets
+        (compiled sooner, the same image) if it has fewer than :data:`QUICK_START_SAMPLES`
+        samples and the kernel with packets is neither compiled nor in numba's cache.
 
     Returns
     -------
@@ -318,10 +352,29 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
                      *plan.by_gradient, *skips,
                      readonly(vector(_NO_MULTIPLIER if multiplier is None else multiplier,
                                      np.int64)),
-                     *tiles, colour, filtering, lit, skipping, packets)
-        on_threads(lambda i: _kernel.raycast(*arguments, plan.scratch[i],
+                     *tiles, colour, filtering, lit, skipping)
+        lanes = (plan.scratch[0], *(a[0] for a in plan.lanes))
+        if (quick_start and packets and _quick_start["on"]
+                and os.environ.get("VRLIB_QUICK_START") != "0"
+                and plan.rays * (plan.diagonal / ds + 2.0) < QUICK_START_SAMPLES
+                and not _packets_ready(arguments, lanes)):
+            packets = None  # a quick start
+        on_threads(lambda i: _kernel.raycast(*arguments, packets, plan.scratch[i],
                                              *(a[i] for a in plan.lanes)), plan.threads)
     return out, int(samples.sum())  # the kernels clip each pixel's opacity
+
+
+def _packets_ready(arguments, lanes):
+    """Whether the ray caster's kernel with packets for ``arguments`` (all but ``packets``
+    and a thread's ``lanes``) is ready without compiling: compiled in this process or in
+    numba's cache (:func:`vrlib._kernels._jit.compiled_or_cached`, which loads it then).
+    A yes is kept per kind of arguments (their types, told apart cheaply)."""
+    kind = tuple(a.dtype.str + a.flags.c_contiguous * "C" + a.flags.writeable * "W"
+                 if isinstance(a, np.ndarray) else type(a) for a in arguments)
+    ready = _quick_start["ready"]
+    if kind not in ready and compiled_or_cached(_kernel.raycast, (*arguments, True, *lanes)):
+        ready.add(kind)
+    return kind in ready
 
 
 #: Stand-ins for the kernels' arrays a render does not use (read-only: shared by every render).
@@ -352,6 +405,10 @@ class RayPlan(NamedTuple):
     #: the tent filter, no shading or gradient opacity, a volume with nothing to skip, make a
     #: smaller kernel, a shorter first wait.
     kind: tuple
+    #: The rays that can meet something, and the length of the box's diagonal (world
+    #: units): how many samples a render can take at most, with the step.
+    rays: int
+    diagonal: float
 
 
 def _ray_plan(data, offset, global_shape, origin, spacing, box, view, filt, transfer, skip,
@@ -415,7 +472,8 @@ def _build_plan(data, offset, global_shape, origin, spacing, box, view, filt, tr
                    # threads' keeps them off each other's lines.
                    np.zeros((threads, 7, MAX_TAPS))[:, :6], _kernel.lanes(threads),
                    (filtering, lit, None if block == 0 else True,
-                    True if filtering is None and lit is None else None))
+                    True if filtering is None and lit is None else None),
+                   int(costs.sum()), float(np.linalg.norm(np.subtract(box[1], box[0]))))
 
 
 def _kept(memo, name, key, build):

@@ -21,6 +21,7 @@ import numba
 import numba.cpython.unsafe.numbers
 from numba import types
 from numba.core import cgutils
+from numba.core.compiler_lock import global_compiler_lock
 from numba.extending import intrinsic
 
 jit = functools.partial(numba.njit, cache=True, nogil=True, error_model="numpy")
@@ -59,6 +60,32 @@ def parallel_jit(function):
 helper_jit = functools.partial(jit, no_cpython_wrapper=True)
 """Decorator of a helper that only compiled code calls: numba builds it no Python wrapper
 (about 0.03 to 0.1 s of a first compile each; it cannot be called from Python)."""
+
+
+def compiled_or_cached(dispatcher, args):
+    """Whether calling the kernel ``dispatcher`` with ``args`` would run without compiling:
+    its signature for them is compiled in this process, or is in numba's on-disk cache
+    (then loaded now, as the call would load it). Never compiles.
+
+    numba has no public call for "load, but do not compile": this takes its dispatcher's
+    cache as numba 0.60 to 0.68 keep it (``_cache``). Where that is missing, or numba's JIT
+    is off, it answers True, so that a caller choosing the kernel to call compiles the one
+    it would have compiled anyway.
+    """
+    cache = getattr(dispatcher, "_cache", None)
+    if numba.config.DISABLE_JIT or cache is None:
+        return True
+    signature = tuple(dispatcher.typeof_pyval(a) for a in args)
+    if signature in dispatcher.overloads:
+        return True
+    with global_compiler_lock:  # as numba's own load, in Dispatcher.compile
+        compiled = cache.load_overload(signature, dispatcher.targetctx)
+        if compiled is None:
+            return False
+        dispatcher.targetctx.insert_user_function(compiled.entry_point, compiled.fndesc,
+                                                  [compiled.library])
+        dispatcher.add_overload(compiled)
+    return True
 
 
 def readonly(array):
