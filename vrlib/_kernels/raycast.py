@@ -314,132 +314,145 @@ def _skip(k, ux, uy, uz, ax, ay, az, bx, by, bz, ds, by_front, empty, clearance,
 
 
 @helper_jit
-def _preintegrated_ray(filtering, data, flat, offset, gshape, inv, d, ax, ay, az,
-                       bx, by, bz, t_in, t_out, k, ds, k_first, k_last, t_first, t_last,
-                       fkind, fp0, fp1, fp2, radius, ntaps, start, vinv, density, psi,
-                       emission, step, grey, col_start, col_inv, mean, shade, ka, kd, ks,
-                       shininess, light, headlight, ramp_x, ramp_y, by_gradient, threshold,
-                       empty, clearance, block, fine_counts, bound, budget, wx, wy, wz, dx,
-                       dy, dz):
-    """One ray, pre-integrated: each segment ``[k ds, (k + 1) ds)`` (cut at the volume's
-    faces) classified from its values at its two ends (the back of one is the front of the
-    next), front to back from segment ``k`` while its middle lies before ``t_out``. Returns
-    ``(r, g, b, a, samples)``. ``filtering`` is None for the tent filter, as in
+def _preintegrated_tile(filtering, row0, col0, tile_h, tile_w, camera, height, width, mask,
+                        box_lo, box_hi, vol_lo, vol_hi, origin, out, data, flat, offset,
+                        gshape, inv, ds, fkind, fp0, fp1, fp2, radius, ntaps, start, vinv,
+                        density, psi, emission, step, grey, col_start, col_inv, mean, shade,
+                        ka, kd, ks, shininess, light, headlight, ramp_x, ramp_y, by_gradient,
+                        threshold, empty, clearance, block, fine_counts, bound, budget, wx, wy,
+                        wz, dx, dy, dz):
+    """The rays of one tile (``tile_h x tile_w`` pixels from ``(row0, col0)``), each
+    pre-integrated: each segment ``[k ds, (k + 1) ds)`` (cut at the volume's faces)
+    classified from its values at its two ends (the back of one is the front of the next),
+    front to back from the ray's first segment while its middle lies before ``t_out``, into
+    ``out``. Returns the samples taken. ``filtering`` is None for the tent filter, as in
     :func:`raycast`: numba drops the other filters' code before typing, so the tent filter's
     loop holds no call (a call in the loop, even one not taken, made it three times slower).
-    The other arguments are :func:`raycast`'s (the table's named without ``pre_``), and
+    A call per tile, not per ray (3 to 7% faster on the MNI152 template at 512^2, one
+    thread). The other arguments are :func:`raycast`'s (the table's named without ``pre_``), and
     ``wx ... dz`` scratch for the filter's weights
     (:func:`~vrlib._kernels.sampling.tap_scratch`)."""
     nx = data.shape[2]
     nxy = data.shape[1] * data.shape[2]
     oz, oy, ox = offset[0], offset[1], offset[2]
     gz, gy, gx = gshape[0], gshape[1], gshape[2]
-    acc_r = 0.0
-    acc_g = 0.0
-    acc_b = 0.0
-    acc_a = 0.0
     taken = 0
-    spent = 0.0
-    t_check = -math.inf if block > 0 else math.inf
-    k_front = -1  # the segment whose front value (and its Psi) `front` holds
-    front = 0.0
-    psi_front = 0.0
-    while True:
-        t = (k + 0.5) * ds
-        cut = k == k_first or k == k_last
-        if cut:
-            t = _cut_segment(k, ds, t_first, t_last)[0]
-            if t < t_in:  # another brick's segment
-                k += 1
-                continue
-        if t >= t_out:
-            break
-        t_a = k * ds
-        t_b = t_a + ds
-        if cut:
-            t_a = max(t_a, t_first)
-            t_b = min(t_b, t_last)
-        if t_a >= t_check:
-            k_next, t_check, spent = _skip(
-                k, ax + t_a * bx, ay + t_a * by, az + t_a * bz, ax, ay, az, bx, by, bz, ds,
-                True, empty, clearance, block, fine_counts, bound, budget, spent,
-                k_first, k_last, t_first, t_last, False)
-            if k_next > k:
-                k = k_next
-                continue
-        if k != k_front:
-            if filtering is None:
-                front = trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ax + t_a * bx,
-                                  ay + t_a * by, az + t_a * bz)
-            else:
-                front = _other_value(data, flat, nx, nxy, oz, oy, ox, gz, gy, gx, offset,
-                                     gshape, ax + t_a * bx, ay + t_a * by, az + t_a * bz,
-                                     fkind, fp0, fp1, fp2, radius, ntaps, wx, wy, wz)
-            psi_front = psi_at(front, start, vinv, density, psi)
-            taken += 1
-        if filtering is None:
-            back = trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ax + t_b * bx,
-                             ay + t_b * by, az + t_b * bz)
-        else:
-            back = _other_value(data, flat, nx, nxy, oz, oy, ox, gz, gy, gx, offset, gshape,
-                                ax + t_b * bx, ay + t_b * by, az + t_b * bz, fkind, fp0, fp1,
-                                fp2, radius, ntaps, wx, wy, wz)
-        psi_back = psi_at(back, start, vinv, density, psi)
-        taken += 1
-        # A cut segment's own length: its opacity is exact, its colour's mean emission that
-        # of a whole segment.
-        length = t_b - t_a if cut else ds
-        if step:
-            alpha, cr, cg, cb = _step_segment(front, back, length, start, vinv, density,
-                                              emission, grey)
-        else:
-            # A linear ramp: the opacity exact from the density's running integral (eq 1.4
-            # with the mean density), the colour from the table of the mean emission.
-            if abs(back - front) * vinv < 1e-6:
-                mean_density = interpolate(density, start, vinv, 0.5 * (front + back))
-            else:
-                mean_density = (psi_back - psi_front) / (back - front)
-            alpha = -math.expm1(-length * mean_density)
-            cr = cg = cb = alpha
-            if alpha > 0.0 and not grey:
-                px = (front - col_start) * col_inv
-                py = (back - col_start) * col_inv
-                n = mean.shape[0]
-                cr = alpha * bilinear_channel(mean, px, py, n, 0)
-                cg = alpha * bilinear_channel(mean, px, py, n, 1)
-                cb = alpha * bilinear_channel(mean, px, py, n, 2)
-        front = back
-        psi_front = psi_back
-        k += 1
-        k_front = k
-        if not alpha > 0.0:
+    for p in range(tile_h * tile_w):
+        r = row0 + p // tile_w
+        c = col0 + p % tile_w
+        hit, d, t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, t_first, t_last = \
+            _pixel_start(r, c, camera, height, width, mask, box_lo, box_hi, vol_lo, vol_hi,
+                         True, origin, inv, ds)
+        if not hit:
             continue
-        if shade or by_gradient:
-            # The gradient at the segment's middle modulates the segment.
-            ux, uy, uz = ax + t * bx, ay + t * by, az + t * bz
+        acc_r = 0.0
+        acc_g = 0.0
+        acc_b = 0.0
+        acc_a = 0.0
+        spent = 0.0
+        t_check = -math.inf if block > 0 else math.inf
+        k_front = -1  # the segment whose front value (and its Psi) `front` holds
+        front = 0.0
+        psi_front = 0.0
+        while True:
+            t = (k + 0.5) * ds
+            cut = k == k_first or k == k_last
+            if cut:
+                t = _cut_segment(k, ds, t_first, t_last)[0]
+                if t < t_in:  # another brick's segment
+                    k += 1
+                    continue
+            if t >= t_out:
+                break
+            t_a = k * ds
+            t_b = t_a + ds
+            if cut:
+                t_a = max(t_a, t_first)
+                t_b = min(t_b, t_last)
+            if t_a >= t_check:
+                k_next, t_check, spent = _skip(
+                    k, ax + t_a * bx, ay + t_a * by, az + t_a * bz, ax, ay, az, bx, by, bz, ds,
+                    True, empty, clearance, block, fine_counts, bound, budget, spent,
+                    k_first, k_last, t_first, t_last, False)
+                if k_next > k:
+                    k = k_next
+                    continue
+            if k != k_front:
+                if filtering is None:
+                    front = trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ax + t_a * bx,
+                                      ay + t_a * by, az + t_a * bz)
+                else:
+                    front = _other_value(data, flat, nx, nxy, oz, oy, ox, gz, gy, gx, offset,
+                                         gshape, ax + t_a * bx, ay + t_a * by, az + t_a * bz,
+                                         fkind, fp0, fp1, fp2, radius, ntaps, wx, wy, wz)
+                psi_front = psi_at(front, start, vinv, density, psi)
+                taken += 1
             if filtering is None:
-                gx_, gy_, gz_ = tent_gradient(data, offset, gshape, ux, uy, uz)
+                back = trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ax + t_b * bx,
+                                 ay + t_b * by, az + t_b * bz)
             else:
-                gx_, gy_, gz_ = gradient(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1,
-                                         fp2, radius, ntaps, wx, wy, wz, dx, dy, dz)
-            if headlight:
-                lx, ly, lz = -d[0], -d[1], -d[2]
+                back = _other_value(data, flat, nx, nxy, oz, oy, ox, gz, gy, gx, offset, gshape,
+                                    ax + t_b * bx, ay + t_b * by, az + t_b * bz, fkind, fp0, fp1,
+                                    fp2, radius, ntaps, wx, wy, wz)
+            psi_back = psi_at(back, start, vinv, density, psi)
+            taken += 1
+            # A cut segment's own length: its opacity is exact, its colour's mean emission that
+            # of a whole segment.
+            length = t_b - t_a if cut else ds
+            if step:
+                alpha, cr, cg, cb = _step_segment(front, back, length, start, vinv, density,
+                                                  emission, grey)
             else:
-                lx, ly, lz = light[0], light[1], light[2]
-            alpha, cr, cg, cb = modulate_by_gradient(
-                alpha, cr, cg, cb, gx_ * inv[0], gy_ * inv[1], gz_ * inv[2], by_gradient,
-                ramp_x, ramp_y, shade, lx, ly, lz, d[0], d[1], d[2], ka, kd, ks, shininess)
+                # A linear ramp: the opacity exact from the density's running integral (eq 1.4
+                # with the mean density), the colour from the table of the mean emission.
+                if abs(back - front) * vinv < 1e-6:
+                    mean_density = interpolate(density, start, vinv, 0.5 * (front + back))
+                elif psi_back == psi_front:  # no density between them (a zero division
+                    mean_density = 0.0           # saved: the same zero)
+                else:
+                    mean_density = (psi_back - psi_front) / (back - front)
+                alpha = -math.expm1(-length * mean_density)
+                cr = cg = cb = alpha
+                if alpha > 0.0 and not grey:
+                    px = (front - col_start) * col_inv
+                    py = (back - col_start) * col_inv
+                    n = mean.shape[0]
+                    cr = alpha * bilinear_channel(mean, px, py, n, 0)
+                    cg = alpha * bilinear_channel(mean, px, py, n, 1)
+                    cb = alpha * bilinear_channel(mean, px, py, n, 2)
+            front = back
+            psi_front = psi_back
+            k += 1
+            k_front = k
             if not alpha > 0.0:
                 continue
-        # Front-to-back over, eqs 1.7-1.8.
-        remaining = 1.0 - acc_a
-        acc_r += remaining * cr
-        acc_g += remaining * cg
-        acc_b += remaining * cb
-        acc_a += remaining * alpha
-        if acc_a >= threshold:
-            break
-    return acc_r, acc_g, acc_b, acc_a, taken
+            if shade or by_gradient:
+                # The gradient at the segment's middle modulates the segment.
+                ux, uy, uz = ax + t * bx, ay + t * by, az + t * bz
+                if filtering is None:
+                    gx_, gy_, gz_ = tent_gradient(data, offset, gshape, ux, uy, uz)
+                else:
+                    gx_, gy_, gz_ = gradient(data, offset, gshape, ux, uy, uz, fkind, fp0, fp1,
+                                             fp2, radius, ntaps, wx, wy, wz, dx, dy, dz)
+                if headlight:
+                    lx, ly, lz = -d[0], -d[1], -d[2]
+                else:
+                    lx, ly, lz = light[0], light[1], light[2]
+                alpha, cr, cg, cb = modulate_by_gradient(
+                    alpha, cr, cg, cb, gx_ * inv[0], gy_ * inv[1], gz_ * inv[2], by_gradient,
+                    ramp_x, ramp_y, shade, lx, ly, lz, d[0], d[1], d[2], ka, kd, ks, shininess)
+                if not alpha > 0.0:
+                    continue
+            # Front-to-back over, eqs 1.7-1.8.
+            remaining = 1.0 - acc_a
+            acc_r += remaining * cr
+            acc_g += remaining * cg
+            acc_b += remaining * cb
+            acc_a += remaining * alpha
+            if acc_a >= threshold:
+                break
+        _put_pixel(out, r, c, acc_r, acc_g, acc_b, acc_a)
+    return taken
 
 
 @helper_jit
@@ -537,7 +550,7 @@ def raycast_preintegrated(data, offset, gshape, origin, spacing, box_lo, box_hi,
                           counter, out, samples, filtering, scratch):
     """:func:`raycast` with pre-integrated classification (a kernel of its own, so that a
     render compiles only the loop it runs): each segment is classified from its values at
-    its two ends (:func:`_preintegrated_ray`), always cut at the volume's faces. The
+    its two ends (:func:`_preintegrated_tile`), always cut at the volume's faces. The
     opacity comes from the mean density (``pre_density`` and its running integral
     ``pre_psi`` on the grid ``(value - pre_start) * pre_inv``), the colour as the opacity
     times the mean emission ``pre_mean[front, back]`` (grid ``(value - col_start) *
@@ -562,25 +575,13 @@ def raycast_preintegrated(data, offset, gshape, origin, spacing, box_lo, box_hi,
         tile_id = order[it]
         row0 = (tile_id // tiles_across) * tile_h
         col0 = (tile_id % tiles_across) * tile_w
-        taken = 0
-        for p in range(tile_h * tile_w):
-            r = row0 + p // tile_w
-            c = col0 + p % tile_w
-            hit, d, t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, t_first, t_last = \
-                _pixel_start(r, c, camera, height, width, mask, box_lo, box_hi, vol_lo,
-                             vol_hi, True, origin, inv, ds)
-            if not hit:
-                continue
-            rgba = _preintegrated_ray(
-                filtering, data, flat, offset, gshape, inv, d, ax, ay, az, bx, by, bz, t_in,
-                t_out, k, ds, k_first, k_last, t_first, t_last, fkind, fp0, fp1, fp2, radius,
-                ntaps, pre_start, pre_inv, pre_density, pre_psi, pre_emission, pre_step,
-                pre_grey, col_start, col_inv, pre_mean, shade, ka, kd, ks, shininess, light,
-                headlight, ramp_x, ramp_y, by_gradient, threshold, empty, clearance, block,
-                fine_counts, bound, budget, wx, wy, wz, dx, dy, dz)
-            _put_pixel(out, r, c, rgba[0], rgba[1], rgba[2], rgba[3])
-            taken += rgba[4]
-        samples[tile_id] = taken
+        samples[tile_id] = _preintegrated_tile(
+            filtering, row0, col0, tile_h, tile_w, camera, height, width, mask, box_lo,
+            box_hi, vol_lo, vol_hi, origin, out, data, flat, offset, gshape, inv, ds, fkind,
+            fp0, fp1, fp2, radius, ntaps, pre_start, pre_inv, pre_density, pre_psi,
+            pre_emission, pre_step, pre_grey, col_start, col_inv, pre_mean, shade, ka, kd, ks,
+            shininess, light, headlight, ramp_x, ramp_y, by_gradient, threshold, empty,
+            clearance, block, fine_counts, bound, budget, wx, wy, wz, dx, dy, dz)
 
 
 @jit
