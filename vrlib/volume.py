@@ -10,7 +10,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import ndimage
 
 from vrlib import validate
 from vrlib.holes import hole_value
@@ -591,8 +590,10 @@ def block_extremes(arr, block, reduce, *, margin=0):
     >>> block_extremes(arr, 4, np.max)[:, 1, 1].tolist()
     [0.0, 1.0]
     """
-    window = {np.min: ndimage.minimum_filter, np.max: ndimage.maximum_filter}[reduce]
     if margin:
+        from scipy import ndimage  # here: SciPy's import is a quarter of vrlib's
+
+        window = {np.min: ndimage.minimum_filter, np.max: ndimage.maximum_filter}[reduce]
         # Widen every sample's reach by `margin` before the block reduction (separable).
         arr = window(arr, size=2 * margin + 1, mode="nearest")
     for axis in range(3):
