@@ -67,10 +67,11 @@ def compiled_or_cached(dispatcher, args):
     its signature for them is compiled in this process, or is in numba's on-disk cache
     (then loaded now, as the call would load it). Never compiles.
 
-    numba has no public call for "load, but do not compile": this takes its dispatcher's
-    cache as numba 0.60 to 0.68 keep it (``_cache``). Where that is missing, or numba's JIT
-    is off, it answers True, so that a caller choosing the kernel to call compiles the one
-    it would have compiled anyway.
+    numba has no public call for "load, but do not compile": this takes the dispatcher's
+    cache where numba keeps it (``_cache``, as in numba 0.68) and loads as
+    ``Dispatcher.compile`` does. Where that is missing, or numba's JIT is off, it answers
+    True, so that a caller choosing the kernel to call compiles the one it would have
+    compiled anyway.
     """
     cache = getattr(dispatcher, "_cache", None)
     if numba.config.DISABLE_JIT or cache is None:
