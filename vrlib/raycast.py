@@ -353,26 +353,27 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
                      readonly(vector(_NO_MULTIPLIER if multiplier is None else multiplier,
                                      np.int64)),
                      *tiles, colour, filtering, lit, skipping)
-        lanes = (plan.scratch[0], *(a[0] for a in plan.lanes))
         if (quick_start and packets and _quick_start["on"]
                 and os.environ.get("VRLIB_QUICK_START") != "0"
                 and plan.rays * (plan.diagonal / ds + 2.0) < QUICK_START_SAMPLES
-                and not _packets_ready(arguments, lanes)):
+                and not _packets_ready(arguments, plan)):
             packets = None  # a quick start
         on_threads(lambda i: _kernel.raycast(*arguments, packets, plan.scratch[i],
                                              *(a[i] for a in plan.lanes)), plan.threads)
     return out, int(samples.sum())  # the kernels clip each pixel's opacity
 
 
-def _packets_ready(arguments, lanes):
+def _packets_ready(arguments, plan):
     """Whether the ray caster's kernel with packets for ``arguments`` (all but ``packets``
-    and a thread's ``lanes``) is ready without compiling: compiled in this process or in
-    numba's cache (:func:`vrlib._kernels._jit.compiled_or_cached`, which loads it then).
-    A yes is kept per kind of arguments (their types, told apart cheaply)."""
+    and a thread's scratch and lanes, from ``plan``) is ready without compiling: compiled
+    in this process or in numba's cache (:func:`vrlib._kernels._jit.compiled_or_cached`,
+    which loads it then). A yes is kept per kind of arguments (their types, told apart
+    cheaply)."""
     kind = tuple(a.dtype.str + a.flags.c_contiguous * "C" + a.flags.writeable * "W"
                  if isinstance(a, np.ndarray) else type(a) for a in arguments)
     ready = _quick_start["ready"]
-    if kind not in ready and compiled_or_cached(_kernel.raycast, (*arguments, True, *lanes)):
+    if kind not in ready and compiled_or_cached(
+            _kernel.raycast, (*arguments, True, plan.scratch[0], *(a[0] for a in plan.lanes))):
         ready.add(kind)
     return kind in ready
 
