@@ -355,6 +355,38 @@ def test_quick_starts_only_where_asked(monkeypatch, tmp_path):
     assert len(asked) == 3 and out.exists() and state["on"] == 0
 
 
+@pytest.mark.parametrize("classification", ["point", "preintegrated"])
+def test_a_quick_start_of_a_sparse_volume_skips_nothing(monkeypatch, classification):
+    """A quick start of a volume with empty space, while the kernels that skip are not
+    compiled, gives the image of a render that skips, bit for bit: point classification
+    samples the visible box through (more samples, the kernel without skipping, which a
+    render that skips had not taken), pre-integration keeps skipping but casts every pixel's
+    ray instead of compiling the footprint mask's kernel (not called). A quick start that
+    dropped a sample that counts, or lost the visible box's samples, would differ."""
+    field = data_gen.make_field("random-blobs", count=3, seed=5, sigma=(0.04, 0.06))
+    data = field.sample(40).data.copy()
+    data[data < 1e-3] = 0.0
+    vol = Volume(data)
+    view = View.orbit(azimuth=37, elevation=23, size=36)
+    options = dict(transfer=TABLE, classification=classification, step=0.7)
+    skipped = render(vol, view, **options)
+    monkeypatch.setenv("VRLIB_QUICK_START", "1")
+    monkeypatch.setattr(vrlib.raycast, "_quick_start", {"on": 0, "ready": set()})
+    monkeypatch.setattr(vrlib.raycast, "compiled_or_cached", lambda d, a: False)
+    monkeypatch.setattr(vrlib.skipping, "compiled_or_cached", lambda d, a: False)
+
+    def no_mask(*args):
+        raise AssertionError("the footprint mask's kernel was called")
+
+    monkeypatch.setattr(vrlib.raycast, "footprint_mask", no_mask)
+    with vrlib.raycast.quick_starts():
+        quick = render(vol, view, **options)
+    assert np.array_equal(quick.rgba, skipped.rgba)
+    assert quick.rgba[..., 3].max() > 0.3
+    if classification == "point":
+        assert quick.stats.samples > 1.5 * skipped.stats.samples  # sampled through
+
+
 def test_compiled_or_cached_loads_without_compiling(tmp_path):
     """:func:`vrlib._kernels._jit.compiled_or_cached` answers from this process's compiled
     signatures and numba's disk cache, and never compiles: False for a signature neither

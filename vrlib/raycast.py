@@ -27,7 +27,7 @@ from vrlib._scheduling import on_threads
 from vrlib.adaptive import step_multipliers
 from vrlib.image import Image, RenderStats
 from vrlib.prefilter import Tally, prepared
-from vrlib.skipping import BLOCK, footprint_mask, skip_grid, visible_box
+from vrlib.skipping import BLOCK, footprint_mask, footprint_ready, skip_grid, visible_box
 from vrlib.value_bounds import reconstructed_range
 from vrlib.volume import lattice_extent
 
@@ -175,16 +175,27 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
             if not np.any(multiplier > 1):
                 multiplier = None
         # With nothing to skip or stretch, checking would only cost time.
-        if (empty.any() or (bound is not None and np.any(bound <= skip_budget))
-                or multiplier is not None):
+        skipping = (empty.any() or (bound is not None and np.any(bound <= skip_budget))
+                    or multiplier is not None)
+        if skipping:
             box_lo, box_hi = kept("visible box", (grid, box_lo, box_hi),
                                   lambda: visible_box(volume, empty, BLOCK, box_lo, box_hi))
             if preint:  # a segment owned outside the box reaches half a step into it
                 box_lo = np.maximum(box_lo - 0.5 * ds, extent[:, 0])
                 box_hi = np.minimum(box_hi + 0.5 * ds, extent[:, 1])
+            if (one_off and not preint and skip_budget == step_budget == 0.0
+                    and _quick(view.height * view.width, np.linalg.norm(box_hi - box_lo), ds)
+                    and not _skipping_ready(volume, view, (box_lo, box_hi), filt, transfer,
+                                            ds, value_range, exact)):
+                # A quick start: the rays sample the visible box through, as the same
+                # image bit for bit (skipping only leaves out samples that add nothing);
+                # on so few samples skipping saves less than its kernel's compile (1.1 s of
+                # a first render of a volume with empty space).
+                skipping = False
+        if skipping:
             skip = (empty, grid.clearance, BLOCK,
-                    kept("mask", (view, grid), lambda: footprint_mask(view, volume, empty,
-                                                                      BLOCK)))
+                    kept("mask", (view, grid), lambda: _footprint(view, volume, empty, (
+                        box_lo, box_hi), ds, one_off)))
     rgba, taken = cast_rays(
         volume.data, offset=(0, 0, 0), global_shape=volume.shape, origin=volume.origin,
         spacing=volume.spacing, box=(box_lo, box_hi), view=view, filt=filt, transfer=transfer,
@@ -338,42 +349,84 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
         on_threads(lambda i: _kernel.raycast_preintegrated(*arguments, plan.scratch[i]),
                    plan.threads)
     else:
-        tables = transfer.segment_table(ds, *value_range)
-        # Colour equals opacity: white emission, no shading.
-        grey = transfer.shading is None and bool(np.all(tables[4] == 1.0))
-        # The tent filter unlit (a first render's kernel) is compiled without the colour of
-        # a grey table (None); the other kernels take it as a flag (False), one kernel for
-        # both. The exact ends are a flag everywhere (None would drop their code, 0.25 s of
-        # a first compile, but doubled the kernels `make test` compiles).
-        colour = (None if grey else True) if filtering is None and lit is None else not grey
-        exact = bool(exact_ends)
-        arguments = (*plan.layout, exact, view.packed(), view.height, view.width, ds,
-                     *filt.code, filt.radius, filt.taps, *tables, *plan.lighting,
-                     *plan.by_gradient, *skips,
-                     readonly(vector(_NO_MULTIPLIER if multiplier is None else multiplier,
-                                     np.int64)),
-                     *tiles, colour, filtering, lit, skipping)
-        if (quick_start and packets and _quick_start["on"]
-                and os.environ.get("VRLIB_QUICK_START") != "0"
-                and plan.rays * (plan.diagonal / ds + 2.0) < QUICK_START_SAMPLES
-                and not _packets_ready(arguments, plan)):
+        arguments = _point_arguments(plan, view, ds, filt, transfer, value_range, exact_ends,
+                                     skips, multiplier, tiles)
+        if (quick_start and packets and _quick(plan.rays, plan.diagonal, ds)
+                and not _ready(arguments, plan, packets)):
             packets = None  # a quick start
         on_threads(lambda i: _kernel.raycast(*arguments, packets, plan.scratch[i],
                                              *(a[i] for a in plan.lanes)), plan.threads)
     return out, int(samples.sum())  # the kernels clip each pixel's opacity
 
 
-def _packets_ready(arguments, plan):
-    """Whether the ray caster's kernel with packets for ``arguments`` (all but ``packets``
-    and a thread's scratch and lanes, from ``plan``) is ready without compiling: compiled
-    in this process or in numba's cache (:func:`vrlib._kernels._jit.compiled_or_cached`,
-    which loads it then). A yes is kept per kind of arguments (their types, told apart
-    cheaply)."""
+def _footprint(view, volume, empty, box, ds, one_off):
+    """The pixels whose rays can meet a block that is not empty
+    (:func:`vrlib.skipping.footprint_mask`), or on a quick start all of them, while that
+    mask's kernel is neither compiled nor in numba's cache: the same image (a ray outside
+    the mask crosses only empty blocks, whose samples add exactly nothing) without its
+    compile (0.7 s of a first render of a volume with empty space)."""
+    if (one_off and _quick(view.height * view.width, np.linalg.norm(box[1] - box[0]), ds)
+            and not footprint_ready(view, volume, empty, BLOCK)):
+        return np.ones(view.shape, dtype=bool)
+    return footprint_mask(view, volume, empty, BLOCK)
+
+
+def _point_arguments(plan, view, ds, filt, transfer, value_range, exact_ends, skips,
+                     multiplier, tiles):
+    """The point-classifying kernel's arguments (:func:`vrlib._kernels.raycast.raycast`) up
+    to its kind's flags, all but ``packets`` and a thread's scratch and lanes."""
+    tables = transfer.segment_table(ds, *value_range)
+    # Colour equals opacity: white emission, no shading.
+    grey = transfer.shading is None and bool(np.all(tables[4] == 1.0))
+    filtering, lit, skipping, _ = plan.kind
+    # The tent filter unlit (a first render's kernel) is compiled without the colour of a
+    # grey table (None); the other kernels take it as a flag (False), one kernel for both.
+    # The exact ends are a flag everywhere (None would drop their code, 0.25 s of a first
+    # compile, but doubled the kernels `make test` compiles).
+    colour = (None if grey else True) if filtering is None and lit is None else not grey
+    vector = np.ascontiguousarray
+    return (*plan.layout, bool(exact_ends), view.packed(), view.height, view.width, ds,
+            *filt.code, filt.radius, filt.taps, *tables, *plan.lighting, *plan.by_gradient,
+            *skips,
+            readonly(vector(_NO_MULTIPLIER if multiplier is None else multiplier, np.int64)),
+            *tiles, colour, filtering, lit, skipping)
+
+
+def _quick(rays, diagonal, ds):
+    """Whether a one-off render of ``rays`` rays across a box of ``diagonal`` at step ``ds``
+    (world units) may take a quick start (:data:`QUICK_START_SAMPLES`)."""
+    return bool(_quick_start["on"] and os.environ.get("VRLIB_QUICK_START") != "0"
+                and rays * (diagonal / ds + 2.0) < QUICK_START_SAMPLES)
+
+
+def _skipping_ready(volume, view, box, filt, transfer, ds, value_range, exact_ends):
+    """Whether the point-classifying kernel that skips empty blocks is ready, for this
+    render, without compiling (with packets or, where its kind takes them, without): asked
+    with stand-in skip grids of the real ones' types."""
+    stand_in = (np.zeros((1, 1, 1), dtype=bool), np.zeros((1, 1, 1), np.int64), BLOCK,
+                np.ones(view.shape, dtype=bool))
+    plan = _build_plan(volume.data, (0, 0, 0), volume.shape, volume.origin, volume.spacing,
+                       box, view, filt, transfer, stand_in, numba.get_num_threads())
+    skips = (1.0, *plan.grids, readonly(_NO_BOUND), 0.0)
+    tiles = (*TILE, plan.order, np.zeros(1, np.int64), np.zeros(view.shape + (4,)),
+             np.zeros(plan.tiles, dtype=np.int64))
+    arguments = _point_arguments(plan, view, ds, filt, transfer, value_range, exact_ends,
+                                 skips, None, tiles)
+    packets = plan.kind[3]
+    return _ready(arguments, plan, packets) or bool(packets and _ready(arguments, plan, None))
+
+
+def _ready(arguments, plan, packets):
+    """Whether the ray caster's kernel for ``arguments`` (all but ``packets`` and a
+    thread's scratch and lanes, from ``plan``) and ``packets`` is ready without compiling:
+    compiled in this process or in numba's cache
+    (:func:`vrlib._kernels._jit.compiled_or_cached`, which loads it then). A yes is kept
+    per kind of arguments (their types, told apart cheaply)."""
     kind = tuple(a.dtype.str + a.flags.c_contiguous * "C" + a.flags.writeable * "W"
-                 if isinstance(a, np.ndarray) else type(a) for a in arguments)
+                 if isinstance(a, np.ndarray) else type(a) for a in arguments) + (packets,)
     ready = _quick_start["ready"]
-    if kind not in ready and compiled_or_cached(
-            _kernel.raycast, (*arguments, True, plan.scratch[0], *(a[0] for a in plan.lanes))):
+    if kind not in ready and compiled_or_cached(_kernel.raycast, (
+            *arguments, packets, plan.scratch[0], *(a[0] for a in plan.lanes))):
         ready.add(kind)
     return kind in ready
 

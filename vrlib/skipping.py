@@ -20,12 +20,12 @@ from typing import NamedTuple
 import numpy as np
 
 from vrlib._kernels import coverage as _coverage
-from vrlib._kernels._jit import readonly
+from vrlib._kernels._jit import compiled_or_cached, readonly
 from vrlib.value_bounds import value_bounds
 
 __all__ = ["BLOCK", "SkipGrid", "skip_grid", "block_densities", "empty_blocks",
            "brick_empty_blocks", "clearance", "visible_box", "footprint_mask",
-           "transparent_runs"]
+           "footprint_ready", "transparent_runs"]
 
 #: Cells per block (each axis) of the empty-space skipping grid.
 BLOCK = 8
@@ -231,17 +231,29 @@ def footprint_mask(view, lattice, empty, block):
     >>> bool(footprint_mask(view, volume, np.ones((4, 4, 4), dtype=bool), 8).any())
     False
     """
-    mask = np.zeros(view.shape, dtype=bool)
     if empty.all():
-        return mask
-    vector = np.ascontiguousarray
-    if not _coverage.cover(view.packed(), readonly(vector(empty, bool)), int(block),
-                           np.array(lattice.shape[::-1], np.int64) - 1,
-                           vector(lattice.origin, np.float64),
-                           vector(lattice.spacing, np.float64),
-                           np.zeros(view.shape, np.int32), mask):
+        return np.zeros(view.shape, dtype=bool)
+    arguments = _cover_arguments(view, lattice, empty, block)
+    mask = arguments[-1]
+    if not _coverage.cover(*arguments):
         mask[:] = True  # a block reaches behind the eye: keep all
     return mask
+
+
+def footprint_ready(view, lattice, empty, block):
+    """Whether :func:`footprint_mask` runs without compiling its kernel: compiled in this
+    process or in numba's cache (:func:`vrlib._kernels._jit.compiled_or_cached`)."""
+    return compiled_or_cached(_coverage.cover, _cover_arguments(view, lattice, empty, block))
+
+
+def _cover_arguments(view, lattice, empty, block):
+    """:func:`vrlib._kernels.coverage.cover`'s arguments, its scratch and mask (the last)
+    zeroed."""
+    vector = np.ascontiguousarray
+    return (view.packed(), readonly(vector(empty, bool)), int(block),
+            np.array(lattice.shape[::-1], np.int64) - 1, vector(lattice.origin, np.float64),
+            vector(lattice.spacing, np.float64), np.zeros(view.shape, np.int32),
+            np.zeros(view.shape, dtype=bool))
 
 
 _RUNS_KEPT = 8  # run tables cached per volume (one per slicing axis and transfer function)
