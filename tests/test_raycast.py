@@ -368,7 +368,9 @@ def test_a_quick_start_of_a_sparse_volume_skips_nothing(monkeypatch, classificat
     data[data < 1e-3] = 0.0
     vol = Volume(data)
     view = View.orbit(azimuth=37, elevation=23, size=36)
-    options = dict(transfer=TABLE, classification=classification, step=0.7)
+    # Glow and float64: the kernels other tests compile (a test of its own kind of kernel
+    # costs make test seconds of compiling).
+    options = dict(transfer=Glow(12.0), classification=classification, step=0.7)
     skipped = render(vol, view, **options)
     monkeypatch.setenv("VRLIB_QUICK_START", "1")
     monkeypatch.setattr(vrlib.raycast, "_quick_start", {"on": 0, "ready": set()})
