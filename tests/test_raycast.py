@@ -334,10 +334,11 @@ def test_quick_starts_only_where_asked(monkeypatch, tmp_path):
         assert asked == [True] and not state["ready"]  # asked about the packets' kernel
         render(vol, view, tolerance=1e-2)  # pilots and the render share a memo
         assert len(asked) == 1
+        bound = vrlib.raycast.QUICK_START_SAMPLES
         monkeypatch.setattr(vrlib.raycast, "QUICK_START_SAMPLES", 1)
         render(vol, view)
         assert len(asked) == 1  # many samples
-        monkeypatch.setattr(vrlib.raycast, "QUICK_START_SAMPLES", 1 << 22)
+        monkeypatch.setattr(vrlib.raycast, "QUICK_START_SAMPLES", bound)
         monkeypatch.setenv("VRLIB_QUICK_START", "0")
         render(vol, view)
         assert len(asked) == 1  # turned off
