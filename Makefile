@@ -48,8 +48,8 @@ venv: $(INSTALLED)
 # and pip's and setuptools' files, 10 s. Compiled up front, because where
 # PYTHONDONTWRITEBYTECODE is set (this project's machines) Python never writes what it
 # compiles: every process compiled every module it imported from source, 1 to 2 s each
-# (`make test` from a fresh clone: 234 -> 197 s of pytest, 7.2 -> 6.1 min of CPU; a first
-# `vrlib render` 0.6 s).
+# (`make test` from a fresh clone, alternated with the Makefile before: 4 min 10-12 s ->
+# 3 min 34-51 s, install included; a `vrlib render` command 0.9 s).
 $(INSTALLED): pyproject.toml constraints.txt
 	@test -x $(PY) || $(PYTHON) -m venv $(VENV)
 	$(PY) -m pip install --quiet --disable-pip-version-check --no-compile -c constraints.txt \
