@@ -710,8 +710,6 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                 if packets is None and filtering is None and lighting is None:
                     # A quick start's kernel (the tent filter unlit, without packets) calls
                     # the set-up compiled apart; every other kernel has it inline.
-                    if r >= height or c >= width or not mask[r, c]:
-                        continue  # no ray: no call
                     hit, d, t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, \
                         t_first, t_last = _pixel_start_apart(
                             r, c, camera, height, width, mask, box_lo, box_hi, vol_lo, vol_hi,
