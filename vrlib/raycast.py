@@ -338,7 +338,7 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
     plan = _ray_plan(data, offset, global_shape, origin, spacing, box, view, filt, transfer,
                      skip, memo)
     vector = np.ascontiguousarray
-    out = np.zeros(view.shape + (4,))
+    out = np.empty(view.shape + (4,))  # each tile cleared by the thread that takes it
     samples = np.zeros(plan.tiles, dtype=np.int64)
     skips = (early_termination, *plan.grids,
              readonly(vector(_NO_BOUND if bound is None else bound, np.float64)), float(budget))
@@ -451,8 +451,8 @@ class RayPlan(NamedTuple):
     by_gradient: tuple
     #: The skip grids (empty, clearance, block, pixel mask), as the kernel takes them.
     grids: tuple
-    #: The tiles whose pixels' rays can meet something, heaviest first; how many tiles the
-    #: image has.
+    #: The tiles whose pixels' rays can meet something, heaviest first, then the others as
+    #: ``-1 - tile`` (only cleared); how many tiles the image has.
     order: np.ndarray
     tiles: int
     threads: int
@@ -506,14 +506,13 @@ def _build_plan(data, offset, global_shape, origin, spacing, box, view, filt, tr
         ramp.magnitudes, ramp.factors, True)
     rows, cols = -(-view.height // TILE[0]), -(-view.width // TILE[1])
     # Cost of a tile: the pixels whose rays can meet something visible; the threads take the
-    # heaviest tiles first. Tiles without such a pixel stay transparent and are not handed
-    # out at all.
+    # heaviest tiles first, then clear the tiles without such a pixel (as -1 - tile).
     padded = np.zeros((rows * TILE[0], cols * TILE[1]), np.uint8)
     padded[: view.height, : view.width] = mask
     costs = np.add.reduce(padded.reshape(rows, TILE[0], cols * TILE[1]), axis=1,
                           dtype=np.int32)  # a tile's rows, then its columns
     costs = np.add.reduce(costs.reshape(rows, cols, TILE[1]), axis=2).ravel()
-    live = np.flatnonzero(costs)
+    live = costs > 0
     # One array type per argument (read-only samples and grids, contiguous vectors): every
     # other combination would compile the kernel once more.
     vector = np.ascontiguousarray
@@ -526,7 +525,8 @@ def _build_plan(data, offset, global_shape, origin, spacing, box, view, filt, tr
     filtering = None if filt.code[0] == TENT else True
     lit = None if shading is None and ramp is None else True
     return RayPlan(layout, lighting, by_gradient, grids,
-                   live[np.argsort(-costs[live], kind="stable")], rows * cols, threads,
+                   np.concatenate((np.argsort(-costs, kind="stable")[: np.count_nonzero(live)],
+                                   -1 - np.flatnonzero(~live))), rows * cols, threads,
                    # Rows of MAX_TAPS = 8 floats, a cache line; an unused row between two
                    # threads' keeps them off each other's lines.
                    np.zeros((threads, 7, MAX_TAPS))[:, :6], _kernel.lanes(threads),

@@ -534,6 +534,23 @@ def _pixel_start_apart(r, c, camera, height, width, mask, box_lo, box_hi, vol_lo
                         exact, origin, inv, ds)
 
 
+@helper_jit
+def _open_tile(entry, tiles_across, tile_h, tile_w, out):
+    """The tile an entry of the kernels' ``order`` names: its number, first row and first
+    column, and whether its rays are cast (an entry ``-1 - tile`` names a tile none of whose
+    rays can meet anything). Its pixels are made transparent first: ``out`` comes
+    uncleared, so that each thread clears the tiles it takes (clearing a 512^2 image before
+    the render took 0.9 ms on one thread, a tenth of a sparse render on two)."""
+    tile = entry if entry >= 0 else -1 - entry
+    row0 = (tile // tiles_across) * tile_h
+    col0 = (tile % tiles_across) * tile_w
+    for r in range(row0, min(row0 + tile_h, out.shape[0])):
+        for c in range(col0, min(col0 + tile_w, out.shape[1])):
+            for channel in range(4):
+                out[r, c, channel] = 0.0
+    return tile, row0, col0, entry >= 0
+
+
 @jit(inline="always")
 def _loop_views(data, offset, gshape, origin, spacing, camera, light, ramp_x, ramp_y, empty,
                 clearance, bound, scratch):
@@ -593,9 +610,9 @@ def raycast_preintegrated(data, offset, gshape, origin, spacing, box_lo, box_hi,
         it = take(counter)
         if it >= order.shape[0]:
             break
-        tile_id = order[it]
-        row0 = (tile_id // tiles_across) * tile_h
-        col0 = (tile_id % tiles_across) * tile_w
+        tile_id, row0, col0, cast = _open_tile(order[it], tiles_across, tile_h, tile_w, out)
+        if not cast:
+            continue
         samples[tile_id] = _preintegrated_tile(
             filtering, row0, col0, tile_h, tile_w, camera, height, width, mask, box_lo,
             box_hi, vol_lo, vol_hi, origin, out, data, flat, offset, gshape, inv, ds, fkind,
@@ -614,9 +631,9 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
             threshold, empty, clearance, block, mask, bound, budget, multiplier, tile_h, tile_w,
             order, counter, out, samples, colour, filtering, lighting, skipping, packets, scratch,
             rays, steps, ray_state, ray_steps, status):
-    """Render ``out[row, col] = (r, g, b, a)`` premultiplied (``out`` comes transparent: a
-    pixel whose ray meets nothing, and a tile left out of ``order``, stay so); count samples
-    per tile.
+    """Render ``out[row, col] = (r, g, b, a)`` premultiplied (``out`` comes uncleared: each
+    tile is made transparent when taken, and a pixel whose ray meets nothing stays so);
+    count samples per tile.
 
     ``data`` holds the samples from global index ``offset`` on (the whole volume, or a brick
     with ghost samples) of a volume of global shape ``gshape`` whose sample 0 is at world
@@ -624,12 +641,13 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
     image) sample the world box ``[box_lo, box_hi]`` of a volume whose own box is
     ``[vol_lo, vol_hi]`` (cut exactly at its faces when ``exact``). The image is cut into
     ``tile_h x tile_w`` pixel tiles; a call takes the next tile of ``order`` (the heaviest
-    first) from the shared queue ``counter`` (:func:`vrlib._kernels.queue.take`) until none is
-    left. Several threads make the call at once (:func:`vrlib._scheduling.on_threads`; the
-    kernel releases the GIL) and finish together however unevenly the tiles cost; neighbouring
-    rays read neighbouring voxels, so a tile keeps them in cache. Each pixel is computed
-    independently and in a fixed order: the image depends neither on the number of threads nor
-    on which thread took which tile.
+    first, then as ``-1 - tile`` those that are only cleared: :func:`_open_tile`) from the
+    shared queue ``counter`` (:func:`vrlib._kernels.queue.take`) until none is left. Several
+    threads make the call at once (:func:`vrlib._scheduling.on_threads`; the kernel releases
+    the GIL) and finish together however unevenly the tiles cost; neighbouring rays read
+    neighbouring voxels, so a tile keeps them in cache. Each pixel is computed independently
+    and in a fixed order: the image depends neither on the number of threads nor on which
+    thread took which tile.
 
     Skips: ``empty`` flags blocks of ``block`` cells per axis that nothing visible can come
     from, and ``clearance`` (per block, an integer array of the same shape) how far a ray
@@ -690,9 +708,9 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
         it = take(counter)
         if it >= order.shape[0]:
             break
-        tile_id = order[it]
-        row0 = (tile_id // tiles_across) * tile_h
-        col0 = (tile_id % tiles_across) * tile_w
+        tile_id, row0, col0, cast = _open_tile(order[it], tiles_across, tile_h, tile_w, out)
+        if not cast:
+            continue
         taken = 0
         for p0 in range(0, tile_h * tile_w, LANES):
             # A group of LANES pixels. Each lane's ray is marched alone up to where its
