@@ -534,7 +534,7 @@ def _pixel_start_apart(r, c, camera, height, width, mask, box_lo, box_hi, vol_lo
                         exact, origin, inv, ds)
 
 
-@helper_jit
+@jit(inline="always")
 def _open_tile(entry, tiles_across, tile_h, tile_w, out):
     """The tile an entry of the kernels' ``order`` names: its number, first row and first
     column, and whether its rays are cast (an entry ``-1 - tile`` names a tile none of whose
