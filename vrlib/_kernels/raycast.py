@@ -502,7 +502,7 @@ def _pixel_start(r, c, camera, height, width, mask, box_lo, box_hi, vol_lo, vol_
     k = math.ceil(t_in / ds - 0.5) if t_out > t_in else 0
     k_first = k_last = -1
     t_first = t_last = 0.0
-    if exact and t_out > t_in:
+    if exact is not None and exact and t_out > t_in:
         t_first, t_last = ray_box(o, d, vol_lo, vol_hi)
         t_first = max(t_first, 0.0)
         k_first = math.floor(t_first / ds)
@@ -639,7 +639,8 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
     with ghost samples) of a volume of global shape ``gshape`` whose sample 0 is at world
     ``origin``; the rays of the packed view ``camera`` (one per pixel of a ``height x width``
     image) sample the world box ``[box_lo, box_hi]`` of a volume whose own box is
-    ``[vol_lo, vol_hi]`` (cut exactly at its faces when ``exact``). The image is cut into
+    ``[vol_lo, vol_hi]`` (cut exactly at its faces when ``exact``; None, for lattice ends in a
+    quick start's kernel, compiles it without the cut segments' code). The image is cut into
     ``tile_h x tile_w`` pixel tiles; a call takes the next tile of ``order`` (the heaviest
     first, then as ``-1 - tile`` those that are only cleared: :func:`_open_tile`) from the
     shared queue ``counter`` (:func:`vrlib._kernels.queue.take`) until none is left. Several
@@ -777,7 +778,7 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                     while True:
                         t = (k + 0.5) * ds
                         fraction = 1.0
-                        if k == k_first or k == k_last:
+                        if exact is not None and (k == k_first or k == k_last):
                             t, fraction = _cut_segment(k, ds, t_first, t_last)
                             if t < t_in:  # another brick's sample
                                 k += 1
@@ -877,7 +878,8 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                             cr = entry_channel(color_tab, i, w, 0)
                             cg = entry_channel(color_tab, i, w, 1)
                             cb = entry_channel(color_tab, i, w, 2)
-                        if fraction != 1.0:  # a segment cut by the volume's face, or a long one
+                        if (exact is not None or skipping is not None) and fraction != 1.0:
+                            # A segment cut by the volume's face, or a long one.
                             part = _part_of_segment(alpha, fraction)
                             cr *= part / alpha
                             cg *= part / alpha
