@@ -524,7 +524,9 @@ def _build_plan(data, offset, global_shape, origin, spacing, box, view, filt, tr
     costs = np.add.reduce(padded.reshape(rows, TILE[0], cols * TILE[1]), axis=1,
                           dtype=np.int32)  # a tile's rows, then its columns
     costs = np.add.reduce(costs.reshape(rows, cols, TILE[1]), axis=2).ravel()
-    live = costs > 0
+    order = np.argsort(-costs, kind="stable")  # the tiles without cost last, in index order
+    live = np.count_nonzero(costs)
+    order[live:] = -1 - order[live:]
     # One array type per argument (read-only samples and grids, contiguous vectors): every
     # other combination would compile the kernel once more.
     vector = np.ascontiguousarray
@@ -536,9 +538,7 @@ def _build_plan(data, offset, global_shape, origin, spacing, box, view, filt, tr
              readonly(vector(mask, bool)))
     filtering = None if filt.code[0] == TENT else True
     lit = None if shading is None and ramp is None else True
-    return RayPlan(layout, lighting, by_gradient, grids,
-                   np.concatenate((np.argsort(-costs, kind="stable")[: np.count_nonzero(live)],
-                                   -1 - np.flatnonzero(~live))), rows * cols, threads,
+    return RayPlan(layout, lighting, by_gradient, grids, order, rows * cols, threads,
                    # Rows of MAX_TAPS = 8 floats, a cache line; an unused row between two
                    # threads' keeps them off each other's lines.
                    np.zeros((threads, 7, MAX_TAPS))[:, :6], _kernel.lanes(threads),
