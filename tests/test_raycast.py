@@ -422,15 +422,36 @@ def test_compiled_or_cached_loads_without_compiling(tmp_path):
                                      {"classification": "preintegrated"},
                                      {"skip_budget": 1e-2}, {"tolerance": 1e-3}], ids=str)
 @pytest.mark.parametrize("filt", ["trilinear", "catmull-rom", "gaussian"])
-def test_bit_identical_for_one_and_two_threads(filt, options):
+def test_bit_identical_for_one_and_two_threads(filt, options, monkeypatch):
     if numba.config.NUMBA_NUM_THREADS < 2:
         pytest.skip("numba sees a single CPU: nothing to compare")
+    monkeypatch.setattr(vrlib.raycast, "ONE_THREAD_SAMPLES", 0)  # small renders on two too
     vol = data_gen.make_field("marschner-lobb").sample(24)
     view = View.orbit(azimuth=20, elevation=35, size=70)
     one = render(vol, view, filter=filt, threads=1, **options)
     two = render(vol, view, filter=filt, threads=2, **options)
     assert np.array_equal(one.rgba, two.rgba)
     assert one.stats.samples == two.stats.samples
+
+
+@pytest.mark.skipif(numba.config.NUMBA_NUM_THREADS < 2, reason="a single CPU")
+def test_a_small_unlit_tent_render_runs_on_one_thread(monkeypatch):
+    """Below ONE_THREAD_SAMPLES (by the bound on samples) the tent filter's unlit render
+    takes one thread whatever the thread count, the other filters the thread count; the
+    image is the same either way."""
+    calls = []
+    launch = vrlib.raycast.on_threads
+    monkeypatch.setattr(vrlib.raycast, "on_threads",
+                        lambda work, threads: calls.append(threads) or launch(work, threads))
+    vol = data_gen.make_field("marschner-lobb").sample(24)
+    small, large = View.orbit(azimuth=20, elevation=35, size=32), View.orbit(size=160)
+    alone = render(vol, small, threads=2)
+    render(vol, large, threads=2)  # 25600 rays of about 40 samples by the bound
+    render(vol, small, filter="catmull-rom", threads=2)
+    monkeypatch.setattr(vrlib.raycast, "ONE_THREAD_SAMPLES", 0)
+    both = render(vol, small, threads=2)
+    assert calls == [1, 2, 2, 2]
+    assert np.array_equal(alone.rgba, both.rgba)
 
 
 @pytest.mark.parametrize("filt", ["box", "trilinear", "catmull-rom", "gaussian"])

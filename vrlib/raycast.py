@@ -51,6 +51,15 @@ TILE = (8, 128)
 #: saved is 0.9 to 2.7 s. The command line's default image, 256^2, of a volume up to about
 #: 290 samples a side at its default step (half a voxel) lies below the bound.
 QUICK_START_SAMPLES = 1 << 26
+#: A render with the tent filter, unlit, whose samples by the same bound number fewer than
+#: this runs on one thread, whatever the thread count: a second thread costs a second call
+#: of the kernel (its 60 arguments unboxed under the GIL) and a wake-up, more than it
+#: saves on so few samples. On a 2-core Intel Xeon, one-off 32^2 renders at two voxels of
+#: chapter 11's six unlit scenes (a render to a tolerance's pilots): medians 0.53 to 0.86 ms
+#: on two threads, 0.38 to 0.60 on one; 96^2 at two voxels, 338 thousand samples by the
+#: bound, 2.4 ms on two against 3.0. Shading and the other filters cost enough a sample that
+#: two threads gain already at 32^2. The image is the same.
+ONE_THREAD_SAMPLES = 1 << 18
 
 #: Where quick starts are on (:func:`quick_starts`), and the kinds of render whose kernel
 #: with packets is known to be ready.
@@ -360,7 +369,8 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
                 and not _ready(arguments, plan, packets)):
             packets, arguments = None, _without_packets(arguments, plan)  # a quick start
         on_threads(lambda i: _kernel.raycast(*arguments, packets, plan.scratch[i],
-                                             *(a[i] for a in plan.lanes)), plan.threads)
+                                             *(a[i] for a in plan.lanes)),
+                   _threads_for(plan, ds))
     return out, int(samples.sum())  # the kernels clip each pixel's opacity
 
 
@@ -396,6 +406,17 @@ def _point_arguments(plan, view, ds, filt, transfer, value_range, exact_ends, sk
             *skips,
             readonly(vector(_NO_MULTIPLIER if multiplier is None else multiplier, np.int64)),
             *tiles, colour, filtering, lit, skipping)
+
+
+def _threads_for(plan, ds):
+    """The threads a point-classifying render of ``plan`` at step ``ds`` (world units) runs
+    on: one for a small render with the tent filter unlit (:data:`ONE_THREAD_SAMPLES`), else
+    the plan's."""
+    filtering, lit, _, _ = plan.kind
+    if (filtering is None and lit is None
+            and plan.rays * (plan.diagonal / ds + 2.0) < ONE_THREAD_SAMPLES):
+        return 1
+    return plan.threads
 
 
 def _quick(rays, diagonal, ds):
