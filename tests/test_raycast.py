@@ -446,7 +446,7 @@ def test_a_small_unlit_tent_render_runs_on_one_thread(monkeypatch):
     vol = data_gen.make_field("marschner-lobb").sample(24)
     small, large = View.orbit(azimuth=20, elevation=35, size=32), View.orbit(size=160)
     alone = render(vol, small, threads=2)
-    render(vol, large, threads=2)  # 25600 rays of about 40 samples by the bound
+    render(vol, large, threads=2)  # 25600 rays of about 80 samples by the bound
     render(vol, small, filter="catmull-rom", threads=2)
     monkeypatch.setattr(vrlib.raycast, "ONE_THREAD_SAMPLES", 0)
     both = render(vol, small, threads=2)
