@@ -414,16 +414,22 @@ def _threads_for(plan, ds):
     the plan's."""
     filtering, lit, _, _ = plan.kind
     if (filtering is None and lit is None
-            and plan.rays * (plan.diagonal / ds + 2.0) < ONE_THREAD_SAMPLES):
+            and _most_samples(plan.rays, plan.diagonal, ds) < ONE_THREAD_SAMPLES):
         return 1
     return plan.threads
+
+
+def _most_samples(rays, diagonal, ds):
+    """A bound on the samples ``rays`` rays take at step ``ds`` (world units) in a box of
+    ``diagonal``: each ray the whole diagonal, and two samples more for its ends."""
+    return rays * (diagonal / ds + 2.0)
 
 
 def _quick(rays, diagonal, ds):
     """Whether a one-off render of ``rays`` rays across a box of ``diagonal`` at step ``ds``
     (world units) may take a quick start (:data:`QUICK_START_SAMPLES`)."""
     return bool(_quick_start["on"] and os.environ.get("VRLIB_QUICK_START") != "0"
-                and rays * (diagonal / ds + 2.0) < QUICK_START_SAMPLES)
+                and _most_samples(rays, diagonal, ds) < QUICK_START_SAMPLES)
 
 
 def _skipping_ready(volume, view, box, filt, transfer, ds, value_range, exact_ends):
