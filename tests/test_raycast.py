@@ -293,7 +293,9 @@ def test_a_quick_start_gives_the_packets_image(monkeypatch, transfer, segment_en
     or a packet that took a sample more or less than the scalar loop, would differ; so would
     a quick start that took the packets after all (the kernels' signatures tell them
     apart). The quick start's kernel takes lattice ends as None (compiled without the cut
-    segments' code) and exact ends as True; the kernel with packets takes a flag."""
+    segments' code) and exact ends as True; the kernel with packets takes a flag. Only the
+    quick start's kernel takes its helpers compiled apart (``apart`` True, ``inline`` None),
+    the other the reverse, so that neither compiles the other's code."""
     vol = data_gen.make_field("marschner-lobb").sample(24)
     view = View.orbit(azimuth=20, elevation=35, size=70)
     monkeypatch.setenv("VRLIB_QUICK_START", "1")
@@ -310,10 +312,11 @@ def test_a_quick_start_gives_the_packets_image(monkeypatch, transfer, segment_en
     if not numba.config.DISABLE_JIT:  # both tent unlit kernels, told apart by `packets`
         names = list(inspect.signature(raycast_kernel.raycast.py_func).parameters)
         kinds = {tuple(str(s[names.index(n)]) for n in ("filtering", "lighting", "packets",
-                                                        "exact"))
+                                                        "exact", "apart", "inline"))
                  for s in raycast_kernel.raycast.signatures}
         quick_ends = "none" if segment_ends == "lattice" else "bool"
-        assert {("none", "none", "bool", "bool"), ("none", "none", "none", quick_ends)} <= kinds
+        assert {("none", "none", "bool", "bool", "none", "bool"),
+                ("none", "none", "none", quick_ends, "bool", "none")} <= kinds
 
 
 def test_quick_starts_only_where_asked(monkeypatch, tmp_path):

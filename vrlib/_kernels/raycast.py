@@ -629,8 +629,8 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
             tstart, tinv, alpha_tab, color_tab, emit_tab,
             shade, ka, kd, ks, shininess, light, headlight, ramp_x, ramp_y, by_gradient,
             threshold, empty, clearance, block, mask, bound, budget, multiplier, tile_h, tile_w,
-            order, counter, out, samples, colour, filtering, lighting, skipping, packets, scratch,
-            rays, steps, ray_state, ray_steps, status):
+            order, counter, out, samples, colour, filtering, lighting, skipping, packets, apart,
+            inline, scratch, rays, steps, ray_state, ray_steps, status):
     """Render ``out[row, col] = (r, g, b, a)`` premultiplied (``out`` comes uncleared: each
     tile is made transparent when taken, and a pixel whose ray meets nothing stays so);
     count samples per tile.
@@ -675,7 +675,11 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
     tent filter without shading: ``filtering`` and ``lighting`` None) compiles the packets
     below, None leaves them out (every other kind, and a quick start:
     :data:`vrlib.raycast.QUICK_START_SAMPLES`; a branch on ``True`` is typed and compiled
-    whether taken or not: only a None argument drops one). ``scratch`` (6 x ``MAX_TAPS``,
+    whether taken or not: only a None argument drops one). ``apart`` and ``inline``, a pair
+    for that reason, say how a ray's set-up and the tent filter's samples are compiled: True
+    and None in a quick start's kernel (calls to :func:`_pixel_start_apart` and
+    :func:`_trilinear_apart`), None and True in every other (inline), so that neither kind
+    compiles the other's code. ``scratch`` (6 x ``MAX_TAPS``,
     this call's own) holds the filter's weights and their derivatives along x, y and z;
     ``rays, steps, ray_state, ray_steps, status`` are this call's lanes (:func:`lanes`).
 
@@ -726,14 +730,14 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                 c = col0 + (p0 + lane) % tile_w
                 if p0 + lane >= tile_h * tile_w:
                     continue
-                if packets is None and filtering is None and lighting is None:
+                if apart is not None:
                     # A quick start's kernel (the tent filter unlit, without packets) calls
                     # the set-up compiled apart; every other kernel has it inline.
                     hit, d, t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, \
                         t_first, t_last = _pixel_start_apart(
                             r, c, camera, height, width, mask, box_lo, box_hi, vol_lo, vol_hi,
                             exact, origin, inv, ds)
-                else:
+                if inline is not None:
                     hit, d, t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, \
                         t_first, t_last = _pixel_start(
                             r, c, camera, height, width, mask, box_lo, box_hi, vol_lo, vol_hi,
@@ -832,20 +836,22 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                             break
                         # The two common filters unrolled, the others through the general
                         # loop.
-                        if filtering is None and lighting is None and packets is None:
+                        if apart is not None:
                             value = _trilinear_apart(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux,
                                                      uy, uz)  # a quick start's kernel
-                        elif filtering is None or fkind == TENT:
-                            value = trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz)
-                        elif fkind == CUBIC:
-                            value = tricubic(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz,
-                                             fp0, fp1, fp2)
-                        elif ntaps == 4:
-                            value = separable4(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy,
-                                               uz, fkind, fp0, fp1, fp2, radius)
-                        else:
-                            value = reconstruct(data, offset, gshape, ux, uy, uz, fkind, fp0,
-                                                fp1, fp2, radius, ntaps, wx, wy, wz)
+                        if inline is not None:
+                            if filtering is None or fkind == TENT:
+                                value = trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy,
+                                                  uz)
+                            elif fkind == CUBIC:
+                                value = tricubic(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy,
+                                                 uz, fp0, fp1, fp2)
+                            elif ntaps == 4:
+                                value = separable4(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux,
+                                                   uy, uz, fkind, fp0, fp1, fp2, radius)
+                            else:
+                                value = reconstruct(data, offset, gshape, ux, uy, uz, fkind,
+                                                    fp0, fp1, fp2, radius, ntaps, wx, wy, wz)
                         taken += 1
                         k += 1
                         # Classify: segment opacity 1 - exp(-density ds) (eq 1.4) and colour
