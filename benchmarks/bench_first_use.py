@@ -5,8 +5,9 @@ pre-integrated classification), at the command line's default image size (256^2)
 same command once the cache holds the kernels (one run each: a cold run takes up to 20 s).
 The table gives the render as the command line reports it and the whole command (Python's
 start and imports included). The command line's render takes a quick start where it can
-(:func:`vrlib.raycast.quick_starts`): the tent filter's unlit kernel without packets, while
-the one with them is not in the cache, and a kernel without skipping while the one with it
+(:func:`vrlib.raycast.quick_starts`): the quick start's own kernel, the tent filter unlit
+with rays one at a time (:func:`vrlib._kernels.raycast.raycast_quick`), while the kernel with
+packets is not in the cache, and a kernel without skipping while the one with it
 is not; the bench runs it as a user would, with ``VRLIB_QUICK_START`` left out of the
 commands' environment.
 """

@@ -16,7 +16,7 @@ from hypothesis import HealthCheck, settings
 
 pytest_plugins = ["claim_verdicts"]  # the report's claim verdicts, from tests/claims
 
-# The ray caster's quick starts (a one-off small render takes the kernel without packets
+# The ray caster's quick starts (a one-off small render takes its own small kernel
 # while the one with them is not compiled: vrlib.raycast.QUICK_START_SAMPLES) off, here and
 # in the processes the tests start: the suite's renders would otherwise compile both kernels
 # of most kinds. tests/test_raycast.py checks the quick start's image against the packets'.

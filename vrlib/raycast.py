@@ -41,15 +41,18 @@ TILE = (8, 128)
 
 #: A quick start (the command line's render, :func:`quick_starts`): a one-off render of
 #: fewer samples than this (bounded by the rays that can meet something times the box's
-#: diagonal over the step) takes the kernel without packets while the one with them is
-#: neither compiled nor in numba's cache, and without skipping while that kernel is not.
-#: The kernel compiles in about three quarters of the time (the packets and their hand-over
-#: are a quarter of a first compile; skipping and its footprint mask 1.8 s more) and gives
-#: the same image bit for bit. What the slower loop costs stays below what it saves: dense
-#: Marschner-Lobb 256^3 -> 256^2 at half a voxel (58 M by the bound, 11 M samples taken)
-#: 121 ms against 49 ms with packets, six sparse blobs 40 ms against 5 ms, where the compile
-#: saved is 0.9 to 2.7 s. The command line's default image, 256^2, of a volume up to about
-#: 290 samples a side at its default step (half a voxel) lies below the bound.
+#: diagonal over the step) takes a kernel of its own,
+#: :func:`vrlib._kernels.raycast.raycast_quick` (the tent filter unlit, rays one at a time,
+#: nothing skipped), while the kernel with packets is neither compiled nor in numba's
+#: cache, and renders without skipping while that kernel is not. It gives the same image
+#: bit for bit and compiles in about two thirds of the time that the packets' kernel took
+#: compiled without its packets: a first `vrlib render gaussian-blob:32` on a 2-core Intel
+#: Xeon took 3.8 to 4.6 s against 5.7 to 6.2 (docs/kernel.md), and 8.3 to 10.4 s with the
+#: kernel with packets and skipping. What the slower loop costs stays below what it saves:
+#: dense Marschner-Lobb 256^3 -> 256^2 at half a voxel (58 M by the bound, 11 M samples
+#: taken) 121 ms against 49 ms with packets, six sparse blobs 40 ms against 5 ms, where the
+#: compile saved is 0.9 to 2.7 s. The command line's default image, 256^2, of a volume up
+#: to about 290 samples a side at its default step (half a voxel) lies below the bound.
 QUICK_START_SAMPLES = 1 << 26
 #: A render with the tent filter, unlit, whose samples by the same bound number fewer than
 #: this runs on one thread, whatever the thread count: a second thread costs a second call
@@ -334,9 +337,11 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
         Keeps what does not depend on the step (:class:`RayPlan`) between calls that give
         the same objects for all else: renders of one scene at several steps.
     quick_start : bool
-        A one-off render, which inside :func:`quick_starts` takes the kernel without packets
-        (compiled sooner, the same image) if it has fewer than :data:`QUICK_START_SAMPLES`
-        samples and the kernel with packets is neither compiled nor in numba's cache.
+        A one-off render, which inside :func:`quick_starts` takes the quick start's kernel
+        (:func:`vrlib._kernels.raycast.raycast_quick`: compiled sooner, the same image) if
+        it is of the tent filter, unlit, skips nothing, has fewer than
+        :data:`QUICK_START_SAMPLES` samples, and the kernel with packets is neither compiled
+        nor in numba's cache.
 
     Returns
     -------
@@ -365,13 +370,14 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
     else:
         arguments = _point_arguments(plan, view, ds, filt, transfer, value_range, exact_ends,
                                      skips, multiplier, tiles)
-        if (quick_start and packets and _quick(plan.rays, plan.diagonal, ds)
-                and not _ready(arguments, plan, packets)):
-            packets, arguments = None, _without_packets(arguments, plan)  # a quick start
-        flags = _kernel_flags(packets, plan)
-        on_threads(lambda i: _kernel.raycast(*arguments, *flags, plan.scratch[i],
-                                             *(a[i] for a in plan.lanes)),
-                   _threads_for(plan, ds))
+        if (quick_start and packets and skipping is None
+                and _quick(plan.rays, plan.diagonal, ds) and not _ready(arguments, plan)):
+            arguments = _quick_arguments(arguments, plan)  # a quick start
+            on_threads(lambda i: _kernel.raycast_quick(*arguments), _threads_for(plan, ds))
+        else:
+            on_threads(lambda i: _kernel.raycast(*arguments, packets, plan.scratch[i],
+                                                 *(a[i] for a in plan.lanes)),
+                       _threads_for(plan, ds))
     return out, int(samples.sum())  # the kernels clip each pixel's opacity
 
 
@@ -399,7 +405,7 @@ def _point_arguments(plan, view, ds, filt, transfer, value_range, exact_ends, sk
     # grey table (None); the other kernels take it as a flag (False), one kernel for both.
     # The exact ends are a flag here (None drops their code, 0.2 s of a first compile, but
     # would double the kernels `make test` compiles): only a quick start's kernel takes None
-    # (_without_packets).
+    # (_quick_arguments).
     colour = (None if grey else True) if filtering is None and lit is None else not grey
     vector = np.ascontiguousarray
     return (*plan.layout, bool(exact_ends), view.packed(), view.height, view.width, ds,
@@ -435,8 +441,7 @@ def _quick(rays, diagonal, ds):
 
 def _skipping_ready(volume, view, box, filt, transfer, ds, value_range, exact_ends):
     """Whether the point-classifying kernel that skips empty blocks is ready, for this
-    render, without compiling (with packets or, where its kind takes them, without): asked
-    with stand-in skip grids of the real ones' types."""
+    render, without compiling: asked with stand-in skip grids of the real ones' types."""
     stand_in = (np.zeros((1, 1, 1), dtype=bool), np.zeros((1, 1, 1), np.int64), BLOCK,
                 np.ones(view.shape, dtype=bool))
     plan = _build_plan(volume.data, (0, 0, 0), volume.shape, volume.origin, volume.spacing,
@@ -446,48 +451,31 @@ def _skipping_ready(volume, view, box, filt, transfer, ds, value_range, exact_en
              np.zeros(plan.tiles, dtype=np.int64))
     arguments = _point_arguments(plan, view, ds, filt, transfer, value_range, exact_ends,
                                  skips, None, tiles)
-    packets = plan.kind[3]
-    return _ready(arguments, plan, packets) or bool(
-        packets and _ready(_without_packets(arguments, plan), plan, None))
+    return _ready(arguments, plan)
 
 
-def _without_packets(arguments, plan):
-    """:func:`_point_arguments`'s ``arguments`` for the tent filter's unlit kernel without
-    packets, a quick start's (:data:`QUICK_START_SAMPLES`): lattice ends come as None, not
-    False, so that the kernel compiles without the cut segments' code (0.2 s less of a first
-    render's wait; only the quick start's kernel takes it so, as the ``make test`` suite,
-    which renders with exact ends and without, compiles the other kernels once for both)."""
+def _quick_arguments(arguments, plan):
+    """:func:`_point_arguments`'s ``arguments`` for a quick start's kernel
+    (:func:`vrlib._kernels.raycast.raycast_quick`, :data:`QUICK_START_SAMPLES`): lattice
+    ends come as None, not False, so that it compiles without the cut segments' code (0.2 s
+    less of a first render's wait; only the quick start's kernel takes them so, as the
+    ``make test`` suite, which renders with exact ends and without, compiles the other
+    kernels once for both)."""
     at = len(plan.layout)
     return (*arguments[:at], True if arguments[at] else None, *arguments[at + 1:])
 
 
-def _kernel_flags(packets, plan):
-    """The point-classifying kernel's flags after :func:`_point_arguments`'s: ``packets``,
-    then ``apart`` and ``inline``, True and None for a quick start's kernel (the tent filter
-    unlit without packets), None and True for every other
-    (:func:`vrlib._kernels.raycast.raycast`). numba compiles both branches on a flag that is
-    not None, taken or not; as a pair, each kind of kernel drops the other's code. Compiled
-    into every other kernel, a quick start's helpers cost its first compile 1.1 to 2.4 s
-    (medians of seven first compiles each, CPU seconds, a 2-core Intel Xeon: tent unlit
-    with packets 10.3 -> 9.2, Catmull-Rom 13.7 -> 12.0, shaded 11.6 -> 9.2); the images and
-    the kernels' speed are the same."""
-    filtering, lit, _, _ = plan.kind
-    quick = packets is None and filtering is None and lit is None
-    return packets, (True if quick else None), (None if quick else True)
-
-
-def _ready(arguments, plan, packets):
+def _ready(arguments, plan):
     """Whether the ray caster's kernel for ``arguments`` (all but ``packets`` and a
-    thread's scratch and lanes, from ``plan``) and ``packets`` is ready without compiling:
-    compiled in this process or in numba's cache
-    (:func:`vrlib._kernels._jit.compiled_or_cached`, which loads it then). A yes is kept
-    per kind of arguments (their types, told apart cheaply)."""
+    thread's scratch and lanes, from ``plan``) is ready without compiling: compiled in this
+    process or in numba's cache (:func:`vrlib._kernels._jit.compiled_or_cached`, which loads
+    it then). A yes is kept per kind of arguments (their types, told apart cheaply)."""
+    packets = plan.kind[3]
     kind = tuple(a.dtype.str + a.flags.c_contiguous * "C" + a.flags.writeable * "W"
                  if isinstance(a, np.ndarray) else type(a) for a in arguments) + (packets,)
     ready = _quick_start["ready"]
     if kind not in ready and compiled_or_cached(_kernel.raycast, (
-            *arguments, *_kernel_flags(packets, plan), plan.scratch[0],
-            *(a[0] for a in plan.lanes))):
+            *arguments, packets, plan.scratch[0], *(a[0] for a in plan.lanes))):
         ready.add(kind)
     return kind in ready
 

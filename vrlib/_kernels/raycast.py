@@ -22,6 +22,10 @@ A sample's position as computed is monotone in ``k``, so the samples whose cells
 the volume form one run per ray (or per stretch between skip checks). With the tent filter
 and no shading, eight rays' runs are taken together in vector form, with no test per sample
 and the same arithmetic, bit for bit (:mod:`vrlib._kernels.packets`, docs/kernel.md).
+
+A first render's quick start (:data:`vrlib.raycast.QUICK_START_SAMPLES`) takes a kernel of its
+own, :func:`raycast_quick`: the same arithmetic, each ray alone, in the fewest lines numba
+has to compile.
 """
 
 from __future__ import annotations
@@ -629,8 +633,8 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
             tstart, tinv, alpha_tab, color_tab, emit_tab,
             shade, ka, kd, ks, shininess, light, headlight, ramp_x, ramp_y, by_gradient,
             threshold, empty, clearance, block, mask, bound, budget, multiplier, tile_h, tile_w,
-            order, counter, out, samples, colour, filtering, lighting, skipping, packets, apart,
-            inline, scratch, rays, steps, ray_state, ray_steps, status):
+            order, counter, out, samples, colour, filtering, lighting, skipping, packets,
+            scratch, rays, steps, ray_state, ray_steps, status):
     """Render ``out[row, col] = (r, g, b, a)`` premultiplied (``out`` comes uncleared: each
     tile is made transparent when taken, and a pixel whose ray meets nothing stays so);
     count samples per tile.
@@ -674,12 +678,8 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
     the time (a first render's wait); ``True`` compiles that path. ``packets`` True (for the
     tent filter without shading: ``filtering`` and ``lighting`` None) compiles the packets
     below, None leaves them out (every other kind, and a quick start:
-    :data:`vrlib.raycast.QUICK_START_SAMPLES`; a branch on ``True`` is typed and compiled
-    whether taken or not: only a None argument drops one). ``apart`` and ``inline``, a pair
-    for that reason, say how a ray's set-up and the tent filter's samples are compiled: True
-    and None in a quick start's kernel (calls to :func:`_pixel_start_apart` and
-    :func:`_trilinear_apart`), None and True in every other (inline), so that neither kind
-    compiles the other's code. ``scratch`` (6 x ``MAX_TAPS``,
+    :data:`vrlib.raycast.QUICK_START_SAMPLES`, takes :func:`raycast_quick`). ``scratch``
+    (6 x ``MAX_TAPS``,
     this call's own) holds the filter's weights and their derivatives along x, y and z;
     ``rays, steps, ray_state, ray_steps, status`` are this call's lanes (:func:`lanes`).
 
@@ -730,18 +730,9 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                 c = col0 + (p0 + lane) % tile_w
                 if p0 + lane >= tile_h * tile_w:
                     continue
-                if apart is not None:
-                    # A quick start's kernel (the tent filter unlit, without packets) calls
-                    # the set-up compiled apart; every other kernel has it inline.
-                    hit, d, t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, \
-                        t_first, t_last = _pixel_start_apart(
-                            r, c, camera, height, width, mask, box_lo, box_hi, vol_lo, vol_hi,
-                            exact, origin, inv, ds)
-                if inline is not None:
-                    hit, d, t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, \
-                        t_first, t_last = _pixel_start(
-                            r, c, camera, height, width, mask, box_lo, box_hi, vol_lo, vol_hi,
-                            exact, origin, inv, ds)
+                hit, d, t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, t_first, \
+                    t_last = _pixel_start(r, c, camera, height, width, mask, box_lo, box_hi,
+                                          vol_lo, vol_hi, exact, origin, inv, ds)
                 if not hit:
                     continue
                 status[lane] = MARCH
@@ -836,22 +827,17 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                             break
                         # The two common filters unrolled, the others through the general
                         # loop.
-                        if apart is not None:
-                            value = _trilinear_apart(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux,
-                                                     uy, uz)  # a quick start's kernel
-                        if inline is not None:
-                            if filtering is None or fkind == TENT:
-                                value = trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy,
-                                                  uz)
-                            elif fkind == CUBIC:
-                                value = tricubic(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy,
-                                                 uz, fp0, fp1, fp2)
-                            elif ntaps == 4:
-                                value = separable4(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux,
-                                                   uy, uz, fkind, fp0, fp1, fp2, radius)
-                            else:
-                                value = reconstruct(data, offset, gshape, ux, uy, uz, fkind,
-                                                    fp0, fp1, fp2, radius, ntaps, wx, wy, wz)
+                        if filtering is None or fkind == TENT:
+                            value = trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz)
+                        elif fkind == CUBIC:
+                            value = tricubic(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz,
+                                             fp0, fp1, fp2)
+                        elif ntaps == 4:
+                            value = separable4(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz,
+                                               fkind, fp0, fp1, fp2, radius)
+                        else:
+                            value = reconstruct(data, offset, gshape, ux, uy, uz, fkind, fp0,
+                                                fp1, fp2, radius, ntaps, wx, wy, wz)
                         taken += 1
                         k += 1
                         # Classify: segment opacity 1 - exp(-density ds) (eq 1.4) and colour
@@ -933,4 +919,97 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                         _put_pixel(out, row0 + (p0 + lane) // tile_w,
                                    col0 + (p0 + lane) % tile_w, rays[RED, lane],
                                    rays[GREEN, lane], rays[BLUE, lane], rays[ALPHA, lane])
+        samples[tile_id] = taken
+
+
+@jit
+def raycast_quick(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_hi, exact,
+                  camera, height, width, ds,
+                  fkind, fp0, fp1, fp2, radius, ntaps,
+                  tstart, tinv, alpha_tab, color_tab, emit_tab,
+                  shade, ka, kd, ks, shininess, light, headlight, ramp_x, ramp_y, by_gradient,
+                  threshold, empty, clearance, block, mask, bound, budget, multiplier, tile_h,
+                  tile_w, order, counter, out, samples, colour, filtering, lighting, skipping):
+    """:func:`raycast` for a quick start (:data:`vrlib.raycast.QUICK_START_SAMPLES`): the tent
+    filter, unlit, nothing skipped, each ray marched alone to its end. The smallest kernel,
+    for a first render's wait: it compiles in about two thirds of the time of
+    :func:`raycast` compiled for the same render without packets (docs/kernel.md), and gives
+    its image bit for bit (the same arithmetic, sample by sample, as :func:`raycast`'s
+    scalar loop and its packets). It takes :func:`raycast`'s arguments up to ``skipping``
+    (one argument list for both kernels) and reads only those of what it renders: the
+    filter's code, the shading, the skip grids and budgets, and the flags ``filtering``,
+    ``lighting`` and ``skipping`` (None, or the render is not a quick start's) go unread.
+    ``exact`` None compiles it without the cut segments' code (lattice ends), ``colour``
+    None without the colour table (white emission: colour equals opacity). A ray's set-up
+    and its samples are calls to helpers compiled apart (:func:`_pixel_start_apart`,
+    :func:`_trilinear_apart`), which shortens the compile further."""
+    data, origin, camera = borrowed(data), borrowed(origin), borrowed(camera)
+    alpha_tab, color_tab = borrowed(alpha_tab), borrowed(color_tab)
+    mask, box_lo, box_hi, vol_lo, vol_hi, out, order, counter, samples = _tile_views(
+        mask, box_lo, box_hi, vol_lo, vol_hi, out, order, counter, samples)
+    flat = data.reshape(-1)
+    inv = (1.0 / spacing[0], 1.0 / spacing[1], 1.0 / spacing[2])
+    tiles_across = (width + tile_w - 1) // tile_w
+    nx = data.shape[2]
+    nxy = data.shape[1] * data.shape[2]
+    oz, oy, ox = offset[0], offset[1], offset[2]
+    gz, gy, gx = gshape[0], gshape[1], gshape[2]
+    ntab = alpha_tab.shape[0]
+    while True:
+        it = take(counter)
+        if it >= order.shape[0]:
+            break
+        tile_id, row0, col0, cast = _open_tile(order[it], tiles_across, tile_h, tile_w, out)
+        if not cast:
+            continue
+        taken = 0
+        for p in range(tile_h * tile_w):
+            r = row0 + p // tile_w
+            c = col0 + p % tile_w
+            hit, d, t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, t_first, \
+                t_last = _pixel_start_apart(r, c, camera, height, width, mask, box_lo, box_hi,
+                                            vol_lo, vol_hi, exact, origin, inv, ds)
+            if not hit:
+                continue
+            acc_r = acc_g = acc_b = acc_a = 0.0
+            while True:
+                t = (k + 0.5) * ds
+                fraction = 1.0
+                if exact is not None and (k == k_first or k == k_last):
+                    t, fraction = _cut_segment(k, ds, t_first, t_last)
+                    if t < t_in:  # another brick's sample
+                        k += 1
+                        continue
+                if t >= t_out:
+                    break
+                value = _trilinear_apart(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ax + t * bx,
+                                         ay + t * by, az + t * bz)
+                taken += 1
+                k += 1
+                # Classify (eqs 1.4 and 1.9, from the table), as raycast does.
+                i, w = lookup((value - tstart) * tinv, ntab)
+                alpha = entry(alpha_tab, i, w)
+                if not alpha > 0.0:
+                    continue  # a transparent segment adds exactly nothing
+                if colour is None or not colour:
+                    cr = cg = cb = alpha  # white emission: colour = opacity
+                else:
+                    cr = entry_channel(color_tab, i, w, 0)
+                    cg = entry_channel(color_tab, i, w, 1)
+                    cb = entry_channel(color_tab, i, w, 2)
+                if exact is not None and fraction != 1.0:  # a segment cut by a face
+                    part = _part_of_segment(alpha, fraction)
+                    cr *= part / alpha
+                    cg *= part / alpha
+                    cb *= part / alpha
+                    alpha = part
+                # Front-to-back over, eqs 1.7-1.8.
+                remaining = 1.0 - acc_a
+                acc_r += remaining * cr
+                acc_g += remaining * cg
+                acc_b += remaining * cb
+                acc_a += remaining * alpha
+                if acc_a >= threshold:
+                    break
+            _put_pixel(out, r, c, acc_r, acc_g, acc_b, acc_a)
         samples[tile_id] = taken
