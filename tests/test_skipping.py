@@ -6,7 +6,13 @@ from naive import reconstruct_naive
 
 import data_gen
 from vrlib import Glow, LookupTransfer, View, Volume, make_filter, render
-from vrlib.skipping import clearance, empty_blocks, footprint_mask, skip_grid
+from vrlib.skipping import (
+    chessboard_distance,
+    clearance,
+    empty_blocks,
+    footprint_mask,
+    skip_grid,
+)
 from vrlib.value_bounds import lattice_sums
 
 
@@ -62,6 +68,20 @@ def test_vectorised_max_density_matches_scalar():
     np.testing.assert_array_equal(many, one)
     for a, b, m in zip(lo[:50], hi[:50], many[:50], strict=True):
         assert m == pytest.approx(tf.opacity_density(np.linspace(a, b, 20001)).max(), abs=1e-3)
+
+
+@pytest.mark.parametrize("shape", [(1, 1, 9), (5, 7, 6), (16, 9, 12)])
+@pytest.mark.parametrize("fraction", [0.3, 0.9, 0.999])
+def test_chessboard_distance_is_scipys(shape, fraction):
+    """The skip grid's distances (NumPy alone) are SciPy's chessboard distance transform's,
+    sparse to dense grids, one with a single block that is not far."""
+    from scipy.ndimage import distance_transform_cdt
+
+    far = np.random.default_rng(len(shape) + int(1000 * fraction)).random(shape) < fraction
+    far.flat[far.size // 3] = False
+    expected = distance_transform_cdt(far, metric="chessboard")
+    assert np.array_equal(chessboard_distance(far), expected)
+    assert expected.max() >= 2 or fraction < 0.5
 
 
 @pytest.mark.parametrize("through", [True, False])

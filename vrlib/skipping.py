@@ -182,17 +182,44 @@ def clearance(empty, *, through=True):
     >>> clearance(empty, through=False)
     array([[[ 1, -1, -1,  1,  2,  3,  4]]])
     """
-    from scipy.ndimage import distance_transform_cdt
-
     reach = np.full(empty.shape, max(empty.shape), dtype=np.int64)
     if empty.all() or not empty.any():
         return reach if empty.all() else -reach
-    away = distance_transform_cdt(empty, metric="chessboard")  # 0 where not empty
+    away = chessboard_distance(empty)  # 0 where not empty
     deep = away >= 2 if through else away >= 1
     if not deep.any():
-        return np.where(empty, away, -reach).astype(np.int64)
-    return np.where(empty, away,
-                    -distance_transform_cdt(~deep, metric="chessboard")).astype(np.int64)
+        return np.where(empty, away, -reach)
+    return np.where(empty, away, -chessboard_distance(~deep))
+
+
+def chessboard_distance(far):
+    """Per element, the chessboard (Chebyshev) distance to the nearest element where ``far``
+    is False (0 there; ``far`` must hold one), as ``scipy.ndimage.distance_transform_cdt(far,
+    metric="chessboard")``: the number of dilations by a cube of 3 elements a side that
+    reach it from those elements. NumPy alone, as SciPy's ndimage takes 0.3 s to import, a
+    tenth of a command line's first render (a grid of 64^3 blocks, for a 512^3 volume:
+    milliseconds).
+
+    Examples
+    --------
+    >>> far = np.ones((1, 1, 6), dtype=bool); far[0, 0, 1] = False
+    >>> chessboard_distance(far).tolist()
+    [[[1, 0, 1, 2, 3, 4]]]
+    """
+    reached = ~far
+    distance = np.zeros(far.shape, dtype=np.int64)
+    step = 0
+    while not reached.all():
+        step += 1
+        grown = reached.copy()
+        for axis in range(far.ndim):  # the cube's dilation, one axis at a time
+            line = np.moveaxis(grown, axis, 0)  # a view: grown changes with it
+            before = line.copy()
+            line[1:] |= before[:-1]
+            line[:-1] |= before[1:]
+        distance[grown & ~reached] = step
+        reached = grown
+    return distance
 
 
 def visible_box(volume, empty, block, lo, hi):
