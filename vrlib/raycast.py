@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import inspect
 import os
 import time
 from typing import NamedTuple
@@ -372,7 +373,7 @@ def cast_rays(data, *, offset, global_shape, origin, spacing, box, view, filt, t
                                      skips, multiplier, tiles)
         if (quick_start and packets and skipping is None
                 and _quick(plan.rays, plan.diagonal, ds) and not _ready(arguments, plan)):
-            arguments = _quick_arguments(arguments, plan)  # a quick start
+            arguments = _quick_arguments(arguments)  # a quick start
             on_threads(lambda i: _kernel.raycast_quick(*arguments), _threads_for(plan, ds))
         else:
             on_threads(lambda i: _kernel.raycast(*arguments, packets, plan.scratch[i],
@@ -454,15 +455,23 @@ def _skipping_ready(volume, view, box, filt, transfer, ds, value_range, exact_en
     return _ready(arguments, plan)
 
 
-def _quick_arguments(arguments, plan):
-    """:func:`_point_arguments`'s ``arguments`` for a quick start's kernel
-    (:func:`vrlib._kernels.raycast.raycast_quick`, :data:`QUICK_START_SAMPLES`): lattice
-    ends come as None, not False, so that it compiles without the cut segments' code (0.2 s
-    less of a first render's wait; only the quick start's kernel takes them so, as the
-    ``make test`` suite, which renders with exact ends and without, compiles the other
-    kernels once for both)."""
-    at = len(plan.layout)
-    return (*arguments[:at], True if arguments[at] else None, *arguments[at + 1:])
+def _quick_arguments(arguments):
+    """Of :func:`_point_arguments`'s ``arguments``, those a quick start's kernel
+    (:func:`vrlib._kernels.raycast.raycast_quick`, :data:`QUICK_START_SAMPLES`) takes, by
+    name; lattice ends come as None, not False, so that it compiles without the cut
+    segments' code (0.2 s less of a first render's wait; only the quick start's kernel takes
+    them so, as the ``make test`` suite, which renders with exact ends and without, compiles
+    the other kernels once for both)."""
+    named = dict(zip(_parameters(_kernel.raycast), arguments, strict=False))  # no lanes
+    named["exact"] = True if named["exact"] else None
+    return tuple(named[name] for name in _parameters(_kernel.raycast_quick))
+
+
+@functools.cache
+def _parameters(kernel):
+    """The names of ``kernel``'s parameters (a numba dispatcher's, or the plain function's
+    with numba's JIT off)."""
+    return tuple(inspect.signature(getattr(kernel, "py_func", kernel)).parameters)
 
 
 def _ready(arguments, plan):

@@ -924,25 +924,19 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
 
 @jit
 def raycast_quick(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_hi, exact,
-                  camera, height, width, ds,
-                  fkind, fp0, fp1, fp2, radius, ntaps,
-                  tstart, tinv, alpha_tab, color_tab, emit_tab,
-                  shade, ka, kd, ks, shininess, light, headlight, ramp_x, ramp_y, by_gradient,
-                  threshold, empty, clearance, block, mask, bound, budget, multiplier, tile_h,
-                  tile_w, order, counter, out, samples, colour, filtering, lighting, skipping):
+                  camera, height, width, ds, tstart, tinv, alpha_tab, color_tab, threshold,
+                  mask, tile_h, tile_w, order, counter, out, samples, colour):
     """:func:`raycast` for a quick start (:data:`vrlib.raycast.QUICK_START_SAMPLES`): the tent
     filter, unlit, nothing skipped, each ray marched alone to its end. The smallest kernel,
     for a first render's wait: it compiles in about two thirds of the time of
     :func:`raycast` compiled for the same render without packets (docs/kernel.md), and gives
     its image bit for bit (the same arithmetic, sample by sample, as :func:`raycast`'s
-    scalar loop and its packets). It takes :func:`raycast`'s arguments up to ``skipping``
-    (one argument list for both kernels) and reads only those of what it renders: the
-    filter's code, the shading, the skip grids and budgets, and the flags ``filtering``,
-    ``lighting`` and ``skipping`` (None, or the render is not a quick start's) go unread.
-    ``exact`` None compiles it without the cut segments' code (lattice ends), ``colour``
-    None without the colour table (white emission: colour equals opacity). A ray's set-up
-    and its samples are calls to helpers compiled apart (:func:`_pixel_start_apart`,
-    :func:`_trilinear_apart`), which shortens the compile further."""
+    scalar loop and its packets). It takes those of :func:`raycast`'s arguments that it
+    reads, by the same names (:func:`vrlib.raycast._quick_arguments`). ``exact`` None
+    compiles it without the cut segments' code (lattice ends), ``colour`` None without the
+    colour table (white emission: colour equals opacity). A ray's set-up and its samples
+    are calls to helpers compiled apart (:func:`_pixel_start_apart`,
+    :func:`_trilinear_apart`): inline, the compile took as long or longer."""
     data, origin, camera = borrowed(data), borrowed(origin), borrowed(camera)
     alpha_tab, color_tab = borrowed(alpha_tab), borrowed(color_tab)
     mask, box_lo, box_hi, vol_lo, vol_hi, out, order, counter, samples = _tile_views(
