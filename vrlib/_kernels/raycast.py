@@ -241,6 +241,24 @@ def _part_of_segment(alpha, fraction):
     return -math.expm1(fraction * math.log1p(-alpha)) if alpha < 1.0 else 1.0
 
 
+@jit(inline="always")
+def _cut_to(fraction, alpha, red, green, blue):
+    """``fraction`` of a segment of opacity ``alpha`` and premultiplied colour ``(red, green,
+    blue)``: ``(alpha, red, green, blue)`` of that part (eq 1.4, the colour scaled with the
+    opacity)."""
+    part = _part_of_segment(alpha, fraction)
+    return part, red * (part / alpha), green * (part / alpha), blue * (part / alpha)
+
+
+@jit(inline="always")
+def _over(acc_r, acc_g, acc_b, acc_a, red, green, blue, alpha):
+    """A ray's sums with a segment of premultiplied colour ``(red, green, blue)`` and
+    opacity ``alpha`` composited behind them, front to back (eqs 1.7-1.8)."""
+    remaining = 1.0 - acc_a
+    return (acc_r + remaining * red, acc_g + remaining * green, acc_b + remaining * blue,
+            acc_a + remaining * alpha)
+
+
 @helper_jit
 def _other_value(data, flat, nx, nxy, oz, oy, ox, gz, gy, gx, offset, gshape, ux, uy, uz,
                  fkind, fp0, fp1, fp2, radius, ntaps, wx, wy, wz):
@@ -447,12 +465,7 @@ def _preintegrated_tile(filtering, row0, col0, tile_h, tile_w, camera, height, w
                     ramp_x, ramp_y, shade, lx, ly, lz, d[0], d[1], d[2], ka, kd, ks, shininess)
                 if not alpha > 0.0:
                     continue
-            # Front-to-back over, eqs 1.7-1.8.
-            remaining = 1.0 - acc_a
-            acc_r += remaining * cr
-            acc_g += remaining * cg
-            acc_b += remaining * cb
-            acc_a += remaining * alpha
+            acc_r, acc_g, acc_b, acc_a = _over(acc_r, acc_g, acc_b, acc_a, cr, cg, cb, alpha)
             if acc_a >= threshold:
                 break
         _put_pixel(out, r, c, acc_r, acc_g, acc_b, acc_a)
@@ -872,17 +885,9 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
                             cb = entry_channel(color_tab, i, w, 2)
                         if (exact is not None or skipping is not None) and fraction != 1.0:
                             # A segment cut by the volume's face, or a long one.
-                            part = _part_of_segment(alpha, fraction)
-                            cr *= part / alpha
-                            cg *= part / alpha
-                            cb *= part / alpha
-                            alpha = part
-                        # Front-to-back over, eqs 1.7-1.8.
-                        remaining = 1.0 - acc_a
-                        acc_r += remaining * cr
-                        acc_g += remaining * cg
-                        acc_b += remaining * cb
-                        acc_a += remaining * alpha
+                            alpha, cr, cg, cb = _cut_to(fraction, alpha, cr, cg, cb)
+                        acc_r, acc_g, acc_b, acc_a = _over(acc_r, acc_g, acc_b, acc_a, cr, cg,
+                                                           cb, alpha)
                         if acc_a >= threshold:
                             break
                     if run:  # the lane waits for the packet where it stands
@@ -992,17 +997,8 @@ def raycast_quick(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo,
                     cg = entry_channel(color_tab, i, w, 1)
                     cb = entry_channel(color_tab, i, w, 2)
                 if exact is not None and fraction != 1.0:  # a segment cut by a face
-                    part = _part_of_segment(alpha, fraction)
-                    cr *= part / alpha
-                    cg *= part / alpha
-                    cb *= part / alpha
-                    alpha = part
-                # Front-to-back over, eqs 1.7-1.8.
-                remaining = 1.0 - acc_a
-                acc_r += remaining * cr
-                acc_g += remaining * cg
-                acc_b += remaining * cb
-                acc_a += remaining * alpha
+                    alpha, cr, cg, cb = _cut_to(fraction, alpha, cr, cg, cb)
+                acc_r, acc_g, acc_b, acc_a = _over(acc_r, acc_g, acc_b, acc_a, cr, cg, cb, alpha)
                 if acc_a >= threshold:
                     break
             _put_pixel(out, r, c, acc_r, acc_g, acc_b, acc_a)
