@@ -690,11 +690,11 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
     a None argument before it types the function, so such a kernel compiles in a fraction of
     the time (a first render's wait); ``True`` compiles that path. ``packets`` True (for the
     tent filter without shading: ``filtering`` and ``lighting`` None) compiles the packets
-    below, None leaves them out (every other kind, and a quick start:
-    :data:`vrlib.raycast.QUICK_START_SAMPLES`, takes :func:`raycast_quick`). ``scratch``
-    (6 x ``MAX_TAPS``,
-    this call's own) holds the filter's weights and their derivatives along x, y and z;
-    ``rays, steps, ray_state, ray_steps, status`` are this call's lanes (:func:`lanes`).
+    below, None leaves them out (every other kind; a quick start,
+    :data:`vrlib.raycast.QUICK_START_SAMPLES`, takes :func:`raycast_quick` instead).
+    ``scratch`` (6 x ``MAX_TAPS``, this call's own) holds the filter's weights and their
+    derivatives along x, y and z; ``rays, steps, ray_state, ray_steps, status`` are this
+    call's lanes (:func:`lanes`).
 
     Rays go in groups of ``LANES`` pixels of a tile row. Each ray is marched alone (the
     checked samples: cut segments, borders, skips, other filters, shading) up to where its
