@@ -205,12 +205,12 @@ class GaussianBlob(Field):
         return -d / self.sigma**2 * self(points)[..., None]
 
     def line_integral(self, origins, directions, t0=-np.inf, t1=np.inf):
+        from scipy import special  # here: SciPy's special functions take 0.3 s to import
+
         o, d = _rays(origins, directions)
         rel = self.center - o
         tc = np.einsum("...i,...i->...", rel, d)  # ray parameter closest to the centre
         r2 = np.einsum("...i,...i->...", rel, rel) - tc**2
-        from scipy import special  # here: SciPy's special functions take 0.3 s to import
-
         s2 = self.sigma * math.sqrt(2.0)
         span = special.erf((np.asarray(t1) - tc) / s2) - special.erf((np.asarray(t0) - tc) / s2)
         peak = self.amplitude * np.exp(-np.maximum(r2, 0.0) / (2 * self.sigma**2))
