@@ -62,6 +62,18 @@ helper_jit = functools.partial(jit, no_cpython_wrapper=True)
 (about 0.03 to 0.1 s of a first compile each; it cannot be called from Python)."""
 
 
+def compiled_apart(helper):
+    """``helper``, a function that kernels inline (``jit(inline="always")``), compiled once
+    more as a helper of its own (:data:`helper_jit`), for a kernel that calls it instead of
+    inlining it. Built from the function itself rather than from a helper that calls it:
+    numba inlines by running the callee's untyped passes and copying its code at the call,
+    which took 0.3 to 0.6 s of a quick start's first compile for its two such helpers
+    (:func:`vrlib._kernels.raycast.raycast_quick`). Inlined, ``helper`` is never compiled
+    on its own (nothing calls it from Python), so only this copy of it is ever compiled and
+    kept in numba's cache under its name. Without the JIT it is the function."""
+    return helper_jit(getattr(helper, "py_func", helper))
+
+
 def compiled_or_cached(dispatcher, args):
     """Whether calling the kernel ``dispatcher`` with ``args`` would run without compiling:
     its signature for them is compiled in this process, or is in numba's on-disk cache

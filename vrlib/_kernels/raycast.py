@@ -34,7 +34,7 @@ import math
 
 import numpy as np
 
-from vrlib._kernels._jit import borrowed, helper_jit, jit, trailing_zeros
+from vrlib._kernels._jit import borrowed, compiled_apart, helper_jit, jit, trailing_zeros
 from vrlib._kernels.camera import pixel_ray, ray_box
 from vrlib._kernels.filters import CUBIC, TENT
 from vrlib._kernels.packets import (
@@ -530,25 +530,15 @@ def _pixel_start(r, c, camera, height, width, mask, box_lo, box_hi, vol_lo, vol_
     return hit, d, t_in, t_out, ax, ay, az, bx, by, bz, k, k_first, k_last, t_first, t_last
 
 
-@helper_jit
-def _trilinear_apart(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz):
-    """:func:`~vrlib._kernels.sampling.trilinear` compiled apart, for a quick start's kernel
-    (as :func:`_pixel_start_apart`; the two shortened its compile by about 0.4 s, and its
-    one-off render of Marschner-Lobb 41^3 at 256^2 took 15.5 ms instead of 13)."""
-    return trilinear(flat, nx, nxy, oz, oy, ox, gz, gy, gx, ux, uy, uz)
-
-
-@helper_jit
-def _pixel_start_apart(r, c, camera, height, width, mask, box_lo, box_hi, vol_lo, vol_hi,
-                       exact, origin, inv, ds):
-    """:func:`_pixel_start` compiled apart, for a quick start's kernel
-    (:data:`vrlib.raycast.QUICK_START_SAMPLES`): called there rather than inlined, it
-    shortens that kernel's compile, a first render's wait, by 0.25 to 0.3 s. Every other
-    kernel keeps it inline: called, it cost the tent filter's kernel with packets 5 to 17%
-    of a render whose rays take few samples (MNI152 at 4 voxels a step), and Catmull-Rom's
-    9 to 11%."""
-    return _pixel_start(r, c, camera, height, width, mask, box_lo, box_hi, vol_lo, vol_hi,
-                        exact, origin, inv, ds)
+#: :func:`_pixel_start` and :func:`~vrlib._kernels.sampling.trilinear` compiled apart, for a
+#: quick start's kernel (:data:`vrlib.raycast.QUICK_START_SAMPLES`): called there rather
+#: than inlined, they shorten that kernel's compile, a first render's wait (its one-off
+#: render of Marschner-Lobb 41^3 at 256^2 took 15.5 ms instead of 13). Every other kernel
+#: keeps them inline: called, :func:`_pixel_start` cost the tent filter's kernel with packets
+#: 5 to 17% of a render whose rays take few samples (MNI152 at 4 voxels a step), and
+#: Catmull-Rom's 9 to 11%.
+_pixel_start_apart = compiled_apart(_pixel_start)
+_trilinear_apart = compiled_apart(trilinear)
 
 
 @jit(inline="always")
