@@ -84,6 +84,13 @@ def test_chessboard_distance_is_scipys(shape, fraction):
     assert expected.max() >= 2 or fraction < 0.5
 
 
+def test_chessboard_distance_refuses_a_grid_with_nothing_to_measure_from():
+    """A grid that is far everywhere has no distance to measure: refused, not dilated for
+    ever."""
+    with pytest.raises(ValueError, match="far must be False somewhere"):
+        chessboard_distance(np.ones((3, 4, 5), dtype=bool))
+
+
 @pytest.mark.parametrize("through", [True, False])
 @pytest.mark.parametrize("seed", range(4))
 def test_clearance_is_how_far_a_ray_may_go_unchecked(seed, through):

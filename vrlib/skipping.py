@@ -207,6 +207,8 @@ def chessboard_distance(far):
     >>> chessboard_distance(far).tolist()
     [[[1, 0, 1, 2, 3, 4]]]
     """
+    if far.all():  # nothing to measure from: the dilations would never end
+        raise ValueError("far must be False somewhere: no element to measure the distance from")
     reached = ~far
     distance = np.zeros(far.shape, dtype=np.int64)
     step = 0

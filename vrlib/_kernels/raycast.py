@@ -646,8 +646,7 @@ def raycast(data, offset, gshape, origin, spacing, box_lo, box_hi, vol_lo, vol_h
     with ghost samples) of a volume of global shape ``gshape`` whose sample 0 is at world
     ``origin``; the rays of the packed view ``camera`` (one per pixel of a ``height x width``
     image) sample the world box ``[box_lo, box_hi]`` of a volume whose own box is
-    ``[vol_lo, vol_hi]`` (cut exactly at its faces when ``exact``; None, for lattice ends in a
-    quick start's kernel, compiles it without the cut segments' code). The image is cut into
+    ``[vol_lo, vol_hi]`` (cut exactly at its faces when ``exact``). The image is cut into
     ``tile_h x tile_w`` pixel tiles; a call takes the next tile of ``order`` (the heaviest
     first, then as ``-1 - tile`` those that are only cleared: :func:`_open_tile`) from the
     shared queue ``counter`` (:func:`vrlib._kernels.queue.take`) until none is left. Several
