@@ -55,15 +55,25 @@ TILE = (8, 128)
 #: compile saved is 0.9 to 2.7 s. The command line's default image, 256^2, of a volume up
 #: to about 290 samples a side at its default step (half a voxel) lies below the bound.
 QUICK_START_SAMPLES = 1 << 26
-#: A render with the tent filter, unlit, whose samples by the same bound number fewer than
-#: this runs on one thread, whatever the thread count: a second thread costs a second call
-#: of the kernel (its 60 arguments unboxed under the GIL) and a wake-up, more than it
-#: saves on so few samples. On a 2-core Intel Xeon, one-off 32^2 renders at two voxels of
-#: chapter 11's six unlit scenes (a render to a tolerance's pilots): medians 0.53 to 0.86 ms
-#: on two threads, 0.38 to 0.60 on one; 96^2 at two voxels, 338 thousand samples by the
-#: bound, 2.4 ms on two against 3.0. Shading and the other filters cost enough a sample that
-#: two threads gain already at 32^2. The image is the same.
+#: A render with the tent filter, unlit, whose work by :func:`_work` (samples by the same
+#: bound, and :data:`RAY_SAMPLES` a ray) comes to less than this runs on one thread,
+#: whatever the thread count: a second thread costs a second call of the kernel (its 60
+#: arguments unboxed under the GIL) and a wake-up, more than it saves on so little. On a
+#: 2-core Intel Xeon, one-off 32^2 renders at two voxels of chapter 11's six unlit scenes (a
+#: render to a tolerance's pilots): medians 0.53 to 0.86 ms on two threads, 0.38 to 0.60 on
+#: one; 96^2 at two voxels, 338 thousand samples by the bound, 2.4 ms on two against 3.0.
+#: Shading and the other filters cost enough a sample that two threads gain already at 32^2.
+#: The image is the same.
 ONE_THREAD_SAMPLES = 1 << 18
+#: What a ray costs before its samples, counted in samples, in the work that picks one thread
+#: or two: its set-up and its first reads, which miss the cache where the volume is larger
+#: than it and the rays lie far apart. Measured (2026-11-29): a render to a tolerance's
+#: 64^2 pilots of Marschner-Lobb 256^3 at 16 voxels, six samples a ray, took 640 ns a ray on
+#: one thread, and 13 ns a sample at one voxel; chapter 11's pilots at 32^2 to 64^2 on 41^3
+#: to 64^3 volumes (steps 2 to 1/4 voxel, one thread against two alternated) were as fast
+#: with it as without, within the noise, and the front's renders to a tolerance at 512^2
+#: 0.92 to 0.96 times the time (``benchmarks/bench_time_error_front.py``'s scenes).
+RAY_SAMPLES = 64
 
 #: Where quick starts are on (:func:`quick_starts`), and the kinds of render whose kernel
 #: with packets is known to be ready.
@@ -422,9 +432,15 @@ def _threads_for(plan, ds):
     the plan's."""
     filtering, lit, _, _ = plan.kind
     if (filtering is None and lit is None
-            and _most_samples(plan.rays, plan.diagonal, ds) < ONE_THREAD_SAMPLES):
+            and _work(plan.rays, plan.diagonal, ds) < ONE_THREAD_SAMPLES):
         return 1
     return plan.threads
+
+
+def _work(rays, diagonal, ds):
+    """A render's work in samples, for the choice of threads: the bound on its samples
+    (:func:`_most_samples`) and :data:`RAY_SAMPLES` for each ray."""
+    return _most_samples(rays, diagonal, ds) + RAY_SAMPLES * rays
 
 
 def _most_samples(rays, diagonal, ds):
