@@ -89,10 +89,13 @@ PILOT_MAX = 64
 #: Steps longer than :data:`MAX_STEP`, up to this (voxels), are tried where the image has at
 #: least :data:`LONGER_PIXELS` times the pilot's pixels: there one more pilot costs less
 #: than the samples a doubled step saves (a rule on sizes, not timings, so that the image
-#: never depends on the machine). 32 voxels, where 16 had been: the front's smooth field
-#: with long low tails (256^3 -> 512^2) meets its peers' errors at 32 voxels, and took it,
-#: in 0.76 to 0.82 times the time (2026-11-29); 72 promises at 384^2 kept as before.
-LONGEST_STEP = 32.0
+#: never depends on the machine). 32 voxels were tried (2026-11-29): the front's smooth
+#: field with long low tails (256^3 -> 512^2) took them, in 0.76 to 0.82 times the time of
+#: 16, but ``method="auto"`` bounds a second filter's time by its samples at this step
+#: (:mod:`vrlib.auto`), and at 32 that bound let Catmull-Rom's pilots run where at 16 it
+#: had spared them: the auto benchmark's dense scene at 512^2 took 1.96 and 1.70 times the
+#: faster filter's time instead of at most 1.50. Not kept.
+LONGEST_STEP = 16.0
 LONGER_PIXELS = 32
 
 
@@ -303,11 +306,11 @@ def _longest_step(volume, view, error, anchor, target, options, images, tried):
     assumed where a long step may not resolve the field. The steps are searched by halves
     (each try one pilot at ``view``, its image kept in ``images``, ``[step, difference]``
     appended to ``tried``), taking a step's passing as meaning that the shorter ones pass:
-    from 2 to 32 voxels, two or three pilots (16 first), where trying each doubling in turn
-    takes one to four, three or four wherever 8 voxels pass. At 512^2 on a 256^3 volume a
-    64^2 pilot's rays miss the cache, so a pilot costs about as much at any long step (1.9
-    ms at 16 voxels against 2.5 at 8 and 3.2 at 4 on Marschner-Lobb). Whatever the order, a
-    step is taken only where its own pilot bears it out.
+    from 2 to 16 voxels, two pilots (8 first), where trying each doubling in turn took one to
+    three, three wherever 8 voxels passed. At 512^2 on a 256^3 volume a 64^2 pilot's rays
+    miss the cache, so a pilot costs about as much at any long step (1.9 ms at 16 voxels
+    against 2.5 at 8 and 3.2 at 4 on Marschner-Lobb). Whatever the order, a step is taken
+    only where its own pilot bears it out.
     """
     candidates = []
     while MAX_STEP * 2.0 ** (len(candidates) + 1) <= LONGEST_STEP:
