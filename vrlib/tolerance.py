@@ -90,11 +90,11 @@ PILOT_MAX = 64
 #: least :data:`LONGER_PIXELS` times the pilot's pixels: there one more pilot costs less
 #: than the samples a doubled step saves (a rule on sizes, not timings, so that the image
 #: never depends on the machine). 32 voxels were tried (2026-11-29): the front's smooth
-#: field with long low tails (256^3 -> 512^2) took them, in 0.76 to 0.82 times the time of
+#: field with long low tails (256^3 -> 512^2) took them, in 0.89 to 0.92 times the time of
 #: 16, but ``method="auto"`` bounds a second filter's time by its samples at this step
 #: (:mod:`vrlib.auto`), and at 32 that bound let Catmull-Rom's pilots run where at 16 it
 #: had spared them: the auto benchmark's dense scene at 512^2 took 1.96 and 1.70 times the
-#: faster filter's time instead of at most 1.50. Not kept.
+#: faster filter's time at 1e-2 and 1e-3, against 0.94 and 1.51 at 16. Not kept.
 LONGEST_STEP = 16.0
 LONGER_PIXELS = 32
 
