@@ -457,6 +457,24 @@ def test_a_small_unlit_tent_render_runs_on_one_thread(monkeypatch):
     assert np.array_equal(alone.rgba, both.rgba)
 
 
+@pytest.mark.skipif(numba.config.NUMBA_NUM_THREADS < 2, reason="a single CPU")
+def test_many_rays_of_few_samples_take_two_threads(monkeypatch):
+    """A ray costs ``RAY_SAMPLES`` samples in the work that picks the threads: 4096 rays at a
+    step of 16 voxels (18 thousand samples by the bound, 281 thousand with the rays) take
+    two threads, as they would not by their samples alone; the image is the same."""
+    calls = []
+    launch = vrlib.raycast.on_threads
+    monkeypatch.setattr(vrlib.raycast, "on_threads",
+                        lambda work, threads: calls.append(threads) or launch(work, threads))
+    vol = data_gen.make_field("marschner-lobb").sample(24)
+    view = View.orbit(azimuth=20, elevation=35, size=64)
+    two = render(vol, view, step=16.0, threads=2)
+    monkeypatch.setattr(vrlib.raycast, "RAY_SAMPLES", 0)
+    one = render(vol, view, step=16.0, threads=2)
+    assert calls == [2, 1]
+    assert np.array_equal(one.rgba, two.rgba)
+
+
 @pytest.mark.parametrize("filt", ["box", "trilinear", "catmull-rom", "gaussian"])
 @pytest.mark.parametrize("transfer", [Glow(5.0), TABLE], ids=["glow", "table"])
 def test_empty_space_skipping_changes_nothing(filt, transfer):
