@@ -60,6 +60,20 @@ def test_a_costlier_sample_is_not_planned_where_its_bound_is_no_faster(scene, tm
     np.testing.assert_array_equal(img.rgba, render(vol, view, tolerance=TOLERANCE).rgba)
 
 
+def test_a_filter_whose_pilots_alone_cost_more_is_not_planned(scene, tmp_path, monkeypatch):
+    """Time by samples only: Catmull-Rom's image at 2 voxels would take half trilinear's
+    samples at 1, but its first two pilots (the whole 24^2 view at 2 and 1 voxels) take one
+    and a half times as many more, so planning it cannot pay: dropped before its pilots."""
+    vol, view = scene
+    model(tmp_path, monkeypatch, c_op=0.0, c_pt=1e-8, c_0=1e-4)
+    img = render(vol, view, method="auto", tolerance=TOLERANCE)
+    rows = candidates(img)
+    assert img.stats.choices["auto"]["filter"] == "trilinear"
+    assert "step" not in rows["catmull-rom"]
+    assert "with its first pilots" in rows["catmull-rom"]["skipped"]
+    assert rows["catmull-rom"]["bound_seconds"] >= rows["trilinear"]["predicted_seconds"]
+
+
 def test_the_filter_predicted_fastest_is_rendered_and_keeps_the_promise(scene, tmp_path,
                                                                         monkeypatch):
     """Time by samples only (every sample costs the same): Catmull-Rom's longer step makes it
