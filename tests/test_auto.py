@@ -62,8 +62,9 @@ def test_a_costlier_sample_is_not_planned_where_its_bound_is_no_faster(scene, tm
 
 def test_a_filter_whose_pilots_alone_cost_more_is_not_planned(scene, tmp_path, monkeypatch):
     """Time by samples only: Catmull-Rom's image at 2 voxels would take half trilinear's
-    samples at 1, but its first two pilots (the whole 24^2 view at 2 and 1 voxels) take one
-    and a half times as many more, so planning it cannot pay: dropped before its pilots."""
+    samples at 1, but its first two pilots (the whole 24^2 view at 2 and 1 voxels) would
+    take one and a half times those on top, so planning it cannot pay: dropped before its
+    pilots."""
     vol, view = scene
     model(tmp_path, monkeypatch, c_op=0.0, c_pt=1e-8, c_0=1e-4)
     img = render(vol, view, method="auto", tolerance=TOLERANCE)

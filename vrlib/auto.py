@@ -23,7 +23,8 @@ points + c_0``, fitted per method by ``vrlib bench``).
   (longer ones are tried only from one that meets the tolerance; see
   :func:`vrlib.tolerance.plan_within`). With the pilots counted (2026-11-29),
   ``benchmarks/bench_auto.py``'s sparse blobs at 512^2 and 1e-3 no longer ran
-  Catmull-Rom's pilots: 0.88 times the faster filter's time instead of 1.54.
+  Catmull-Rom's pilots: 0.88 and 1.11 times the faster filter's time in two runs, instead
+  of 1.54.
 * The candidate with the least predicted time is rendered. Without a cost model on this
   machine the first candidate is, and ``img.stats.choices["auto"]`` says so (``vrlib bench``
   fits one).
