@@ -263,7 +263,8 @@ def test_a_memo_shared_between_renders_changes_no_image():
     """The pilot's renders share what does not depend on the step (``memo``: the footprint
     of the volume's skip grid, the kernel's plan); each image equals the one rendered
     without it, for several steps and two views in turn, and the plan is built once per
-    view."""
+    view. The phase check's view, the last one moved back along its direction, keeps both:
+    its rays lie on the same lines (a perspective view moved back does not: its own)."""
     from vrlib.filters import make_filter
     from vrlib.raycast import render_raycast
 
@@ -284,3 +285,12 @@ def test_a_memo_shared_between_renders_changes_no_image():
     assert plans[0] is not plans[3]
     assert memo["grid"][1].empty.any() and memo["mask"][0][0] is views[-1]
     assert memo["mask"][1].any() and not memo["mask"][1].all()
+    mask = memo["mask"][1]
+    for back in (0.25, 0.75):
+        moved = views[-1].moved_back(back * float(vol.spacing.min()))
+        shared = render_raycast(vol, moved, step=1.0, memo=memo, **options)
+        assert np.array_equal(shared.rgba, render_raycast(vol, moved, step=1.0, **options).rgba)
+        assert memo["ray plan"][1] is plans[-1] and memo["mask"][1] is mask
+    eye = View.orbit(azimuth=30, elevation=20, size=24,
+                     projection="perspective").fitted(vol.extent)
+    assert eye.moved_back(0.1).lines is not eye

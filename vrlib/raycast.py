@@ -222,7 +222,7 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
                 skipping = False
         if skipping:
             skip = (empty, grid.clearance, BLOCK,
-                    kept("mask", (view, grid), lambda: _footprint(view, volume, empty, (
+                    kept("mask", (view.lines, grid), lambda: _footprint(view, volume, empty, (
                         box_lo, box_hi), ds, one_off)))
     rgba, taken = cast_rays(
         volume.data, offset=(0, 0, 0), global_shape=volume.shape, origin=volume.origin,
@@ -542,12 +542,13 @@ class RayPlan(NamedTuple):
 def _ray_plan(data, offset, global_shape, origin, spacing, box, view, filt, transfer, skip,
               memo):
     """:func:`cast_rays`'s :class:`RayPlan`, kept in ``memo`` (a dict, or None) while the
-    samples, view, box, filter, transfer function and skip grids are the same objects and
-    the thread count the same (a render to a tolerance's pilot images at several steps:
-    0.1 ms each at 32^2)."""
+    samples, box, filter, transfer function and skip grids are the same objects, the image
+    the same size and the thread count the same (a render to a tolerance's pilot images at
+    several steps and its phase check's, of the view moved back: 0.1 ms each at 32^2). The
+    plan depends on the view through its size and the pixel mask (a skip grid) alone."""
     threads = numba.get_num_threads()
     key = (data, tuple(offset), tuple(global_shape), tuple(np.asarray(origin).tolist()),
-           tuple(np.asarray(spacing).tolist()), view, box[0], box[1], filt, transfer,
+           tuple(np.asarray(spacing).tolist()), view.shape, box[0], box[1], filt, transfer,
            threads) + (() if skip is None else tuple(skip))
     return _kept({} if memo is None else memo, "ray plan", key, lambda: _build_plan(
         data, offset, global_shape, origin, spacing, box, view, filt, transfer, skip, threads))

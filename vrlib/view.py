@@ -99,6 +99,7 @@ class View:
         self._given = {"up": up, "fov": fov, "distance": distance}
         self._fitted = None  # (box, view): the last framing fitted() made (it reuses it)
         self._seen = None  # (box, answer): the last box sees() was asked about
+        self._lines = None  # the view moved back from (orthographic: the same ray lines)
         center = (0.0, 0.0, 0.0) if center is None else center
         radius = _DEFAULT_RADIUS if radius is None else radius
         f = validate.vector3("forward", forward, unit=True)
@@ -218,7 +219,7 @@ class View:
         ((16, 16), 4.0)
         """
         view = copy.copy(self)  # the same camera (its arrays are read-only), other pixels
-        view._fitted = view._seen = None
+        view._fitted = view._seen = view._lines = None
         view._set_size(size)
         return view
 
@@ -237,6 +238,7 @@ class View:
         """
         view = copy.copy(self)
         view._fitted = view._seen = None
+        view._lines = None if self.is_perspective else self.lines
         view.center = self.center - distance * self.forward
         view.center.flags.writeable = False
         return view
@@ -309,6 +311,21 @@ class View:
     def shape(self):
         """``(height, width)`` of the image in pixels."""
         return (self.height, self.width)
+
+    @property
+    def lines(self):
+        """The view whose rays lie on the same lines as this one's, pixel for pixel: this
+        view, or for an orthographic view :meth:`moved_back`, the view it was moved from.
+        What depends on the rays' lines alone (which pixels' rays can meet a block) is kept
+        for both under it.
+
+        Examples
+        --------
+        >>> view = View.orbit(azimuth=30, size=8, radius=1.0)
+        >>> view.moved_back(0.25).lines is view, view.resized(4).lines is view
+        (True, False)
+        """
+        return self if self._lines is None else self._lines
 
     @property
     def is_perspective(self):
