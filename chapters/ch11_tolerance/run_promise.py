@@ -5,8 +5,10 @@ image of the field the filter reconstructs (the real volume: against a ray cast 
 voxel with exact ends, whose own error is estimated from the one at 1/32), the estimate the
 render reported, its time, and the time of the fastest fixed setting that meets the same
 tolerance (a grid search over the step, with point and pre-integrated classification, exact
-ends, no early termination). Writes
-``build/results/ch11_tolerance/promise.json``.
+ends, no early termination). The grid's times are each the best of a few, and the fastest
+of some thirty noisy minima is a lucky one; so the render to a tolerance and the grid's
+fastest settings are timed again, in turn, and their medians compared as well
+(:func:`alternated`). Writes ``build/results/ch11_tolerance/promise.json``.
 """
 
 import time
@@ -24,6 +26,12 @@ SIZE = by_profile(128, 256)
 GRID_STEPS = [float(2.0 ** (0.5 * k)) for k in range(2, -13, -1)]
 CLASSIFICATIONS = ["point", "preintegrated"]
 REPEATS = 3
+#: Rounds of :func:`alternated`, and how close to the grid's fastest time (a factor) a
+#: setting that meets the tolerance must come to be timed again, at most
+#: :data:`CONTENDERS` of them.
+ROUNDS = 7
+CLOSE = 1.25
+CONTENDERS = 3
 
 
 def timed(render):
@@ -38,15 +46,35 @@ def timed(render):
     return image, best
 
 
+def alternated(renders):
+    """The median wall time of each of ``renders`` (name to function), timed in turn for
+    :data:`ROUNDS` rounds after one warm call each: the machine's slow and fast spells fall
+    on all of them alike, so their ratios hold where one render's best of a few does not."""
+    times = {name: [] for name in renders}
+    for render in renders.values():
+        render()
+    for _ in range(ROUNDS):
+        for name, render in renders.items():
+            start = time.perf_counter()
+            render()
+            times[name].append(time.perf_counter() - start)
+    return {name: float(np.median(seconds)) for name, seconds in times.items()}
+
+
+def fixed_render(volume, view, transfer, row):
+    """The render of the grid's setting ``row``."""
+    return partial(vrlib.render, volume, view, transfer=transfer, step=row["step"],
+                   early_termination=1.0, segment_ends="exact",
+                   classification=row["classification"])
+
+
 def fixed_settings(volume, view, transfer, reference):
     """Error and time of every fixed setting of the grid."""
     rows = []
     for classification in CLASSIFICATIONS:
         for step in GRID_STEPS:
-            image, seconds = timed(partial(vrlib.render, volume, view, transfer=transfer,
-                                           step=step, early_termination=1.0,
-                                           segment_ends="exact",
-                                           classification=classification))
+            row = {"classification": classification, "step": step}
+            image, seconds = timed(fixed_render(volume, view, transfer, row))
             rows.append({"classification": classification, "step": step, "seconds": seconds,
                          "rmse": vrlib.metrics.rmse(image, reference)})
     return rows
@@ -80,15 +108,28 @@ def main():
                     "preintegrated_1_32": vrlib.metrics.rmse(fine[2], fine[1])}
             grid = fixed_settings(volume, view, transfer, reference)
             for tolerance in TOLERANCES:
+                within = partial(vrlib.render, volume, view, transfer=transfer,
+                                 tolerance=tolerance)
                 try:
-                    image, seconds = timed(partial(vrlib.render, volume, view,
-                                                   transfer=transfer, tolerance=tolerance))
+                    image, seconds = timed(within)
                 except ValueError as refusal:
                     cases.append({"scene": key, "label": label, "view": view_name,
                                   "tolerance": tolerance, "refused": str(refusal)})
                     continue
                 meeting = [row for row in grid if row["rmse"] <= tolerance]
                 fastest = min(meeting, key=lambda row: row["seconds"]) if meeting else None
+                again = None
+                if fastest:
+                    close = sorted((row for row in meeting
+                                    if row["seconds"] <= CLOSE * fastest["seconds"]),
+                                   key=lambda row: row["seconds"])[:CONTENDERS]
+                    medians = alternated({"tolerance": within} | {
+                        i: fixed_render(volume, view, transfer, row)
+                        for i, row in enumerate(close)})
+                    best = min(range(len(close)), key=medians.get)
+                    again = {"seconds": medians["tolerance"],
+                             "fixed": close[best] | {"seconds": medians[best]},
+                             "ratio": medians["tolerance"] / medians[best]}
                 choices = image.stats.choices
                 cases.append({
                     "scene": key, "label": label, "view": view_name, "reference": kind,
@@ -97,9 +138,11 @@ def main():
                     "pilot_steps": len(choices["pilot"]["steps"]), "seconds": seconds,
                     "fastest_fixed": fastest,
                     "ratio": seconds / fastest["seconds"] if fastest else None,
+                    "alternated": again,
                 })
     kept = [c for c in cases if "rmse" in c and c["rmse"] <= c["tolerance"]]
     ratios = [c["ratio"] for c in cases if c.get("ratio") is not None]
+    again = [c["alternated"]["ratio"] for c in cases if c.get("alternated")]
     write_json(result_path(__file__, "promise.json"), {
         "cases": cases, "size": SIZE, "grid_steps": GRID_STEPS,
         "shares": {"term": TERM_SHARE, "step": STEP_SHARE},
@@ -111,6 +154,11 @@ def main():
                     "ratio_median": float(np.median(ratios)) if ratios else None,
                     "ratio_max": float(np.max(ratios)) if ratios else None,
                     "timed": len(ratios), "within_1_5": sum(r <= 1.5 for r in ratios),
+                    "alternated": {"ratio_median": float(np.median(again)) if again else None,
+                                   "ratio_max": float(np.max(again)) if again else None,
+                                   "within_1_5": sum(r <= 1.5 for r in again),
+                                   "rounds": ROUNDS, "contenders": CONTENDERS,
+                                   "close": CLOSE},
                     "missed": [f"{c['label']}, {c['view']}, tolerance {c['tolerance']:g} "
                                f"({c['rmse'] / c['tolerance']:.2f} of it; reference: "
                                f"{c['reference']} image)"
