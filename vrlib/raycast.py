@@ -160,7 +160,9 @@ def render_raycast(volume, view, *, filt, transfer, step, early_termination,
     dict, empty at first) keeps what does not depend on the step (the pixels whose rays can
     meet a block, the tiles' order, the kernel's arguments: :class:`RayPlan`) between
     renders of one volume, filter and transfer function, unchanged, at several steps: a
-    render to a tolerance's pilot images. The images are the same with it or without.
+    render to a tolerance's pilot images, and its phase check's, of the view moved back
+    (the same ray lines, :attr:`vrlib.View.lines`). The images are the same with it or
+    without.
     """
     skip_budget = validate.finite_number("skip_budget", skip_budget, low=0.0)
     step_budget = validate.finite_number("step_budget", step_budget, low=0.0)
