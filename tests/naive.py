@@ -625,12 +625,15 @@ def warp_naive(inter, volume, view, axis, q_axis, p_axis, kf, low):
     return np.clip(out, 0.0, 1.0)
 
 
-def shearwarp_naive(volume, view, filt, transfer, blend=None):
+def shearwarp_naive(volume, view, filt, transfer, blend=None, planes=1):
     """Shear-warp by the book: the intermediate image lies on the front slice's plane at its
     resolution; each of its pixels follows its ray (parallel, or from the eye) through every
     slice, resamples the slice where the ray meets it with the 2-D filter and composites front
     to back, each segment as long as the ray's path between slices (half on the end slices);
     then the intermediate image is sampled bilinearly where each pixel's ray meets the plane.
+    With ``planes`` > 1 the ray also meets ``planes - 1`` planes evenly between each two
+    slices, where it samples both slices (at the same in-slice point) and interpolates them
+    linearly, each segment ``1 / planes`` of the path between slices.
     With ``blend`` ("maximum" or "average") a pixel takes the largest or the mean of its
     values instead, classified with the transfer function's unit distance, before the warp."""
     from vrlib.view import principal_axis
@@ -682,14 +685,24 @@ def shearwarp_naive(volume, view, filt, transfer, blend=None):
         for big_i in range(width):
             point = np.array([big_i, big_j], float) + low
             values = []
-            for k in (range(n_k) if ascending else range(n_k - 1, -1, -1)):
+            positions = np.arange(0, n_k - 1 + 0.5 / planes, 1.0 / planes)
+            for k in (positions if ascending else positions[::-1]):
                 (i, j), length = hit(point, k)
+                length /= planes
                 if not (0 <= i <= n_i - 1 and 0 <= j <= n_j - 1):
                     continue
                 jdx = math.floor(j - filt.radius) + 1 + np.arange(taps)
                 idx = math.floor(i - filt.radius) + 1 + np.arange(taps)
                 taps_at = np.ix_(np.clip(jdx, 0, n_j - 1), np.clip(idx, 0, n_i - 1))
-                value = filt(j - jdx) @ slices[k][taps_at] @ filt(i - idx)
+                k0 = min(int(math.floor(k)), n_k - 1)
+                k1, w = min(k0 + 1, n_k - 1), k - k0  # the slices about the plane
+
+                def across(stack, k0=k0, k1=k1, w=w, taps_at=taps_at, i=i, j=j, idx=idx,
+                           jdx=jdx):  # the 2-D filter on both slices, linear between
+                    return ((1 - w) * (filt(j - jdx) @ stack[k0][taps_at] @ filt(i - idx))
+                            + w * (filt(j - jdx) @ stack[k1][taps_at] @ filt(i - idx)))
+
+                value = across(slices)
                 if blend is not None:
                     values.append(value)
                     continue
@@ -697,8 +710,7 @@ def shearwarp_naive(volume, view, filt, transfer, blend=None):
                 density = transfer.opacity_density(np.array([value]))[0]
                 colour = transfer.emission(np.array([value]))[0]
                 if gradients is not None:
-                    grad = np.array([filt(j - jdx) @ g[k][taps_at] @ filt(i - idx)
-                                     for g in gradients])
+                    grad = np.array([across(g) for g in gradients])
                     if transfer.gradient_opacity is not None:
                         density *= transfer.gradient_opacity.factor(np.linalg.norm(grad))
                     if transfer.shading is not None:

@@ -83,6 +83,44 @@ def test_shearwarp_with_gradients_matches_naive_twin(filt, transfer, projection)
     assert fast.alpha.max() > 0.02
 
 
+@pytest.mark.parametrize("planes", [2, 3])
+@pytest.mark.parametrize("filt", ["trilinear", "catmull-rom", "omoms"])
+@pytest.mark.parametrize("transfer", ["table", "lit-table"])
+@pytest.mark.parametrize("projection", ["orthographic", "perspective"])
+def test_shearwarp_planes_match_naive_twin(planes, filt, transfer, projection):
+    """Sample planes between the slices (``planes_per_slice``): each interpolates the two
+    slices about it at the same in-slice point, gradients too, each a segment of ``1 /
+    planes`` of the path between slices (the twin follows each ray through the planes)."""
+    vol = small_volume()
+    view = View.orbit(azimuth=-60, elevation=10, size=(7, 9), projection=projection,
+                      distance=4.0 if projection == "perspective" else None)
+    fast = render(vol, view, method="shearwarp", filter=filt, transfer=TRANSFERS[transfer],
+                  early_termination=1.0, planes_per_slice=planes)
+    slow = shearwarp_naive(vol, view, vrlib.make_filter(filt), TRANSFERS[transfer],
+                           planes=planes)
+    np.testing.assert_allclose(fast.rgba, slow, atol=1e-6)
+    assert fast.alpha.max() > 0.02
+    single = render(vol, view, method="shearwarp", filter=filt, transfer=TRANSFERS[transfer],
+                    early_termination=1.0)
+    assert not np.allclose(fast.rgba, single.rgba, atol=1e-4)  # the planes were sampled
+
+
+@pytest.mark.parametrize("projection", ["orthographic", "perspective"])
+def test_shearwarp_planes_converge_at_second_order_inside(projection):
+    """On a field that vanishes at the volume's faces, the image's change as the planes per
+    slice double falls about four times each doubling (the error along rays is of second
+    order in the planes' spacing; the warp's own error is the same for every count and
+    cancels in the differences). Measured: 3.4 to 4.9 over the first two doublings."""
+    vol = data_gen.make_field("gaussian-blob").sample(17)
+    view = View.orbit(azimuth=100, elevation=-35, size=24, projection=projection,
+                      distance=3.0 if projection == "perspective" else None)
+    images = [render(vol, view, method="shearwarp", planes_per_slice=m,
+                     early_termination=1.0) for m in (1, 2, 4)]
+    changes = [metrics.rmse(a, b) for a, b in zip(images, images[1:], strict=False)]
+    assert changes[0] / changes[1] > 3.0
+    assert changes[1] > 0.0
+
+
 @pytest.mark.parametrize("filt", ["trilinear", "catmull-rom"])
 @pytest.mark.parametrize("azimuth, elevation, distance", [(33, -21, 2.5), (200, 40, 4.0),
                                                           (-60, 80, 9.0)])
@@ -279,6 +317,14 @@ def test_perspective_shearwarp_refuses_an_eye_inside_the_slab():
     [
         ("shearwarp", {"min_opacity": 1.0}, ValueError, "min_opacity must be < 1"),
         ("shearwarp", {"min_opacity": -0.1}, ValueError, "min_opacity must be >= 0"),
+        ("shearwarp", {"planes_per_slice": 0}, ValueError, "planes_per_slice must be an "
+                                                            "integer >= 1"),
+        ("shearwarp", {"planes_per_slice": 65}, ValueError, "planes_per_slice must be an "
+                                                             "integer from 1 to 64"),
+        ("shearwarp", {"planes_per_slice": 1.5}, TypeError, "planes_per_slice must be an "
+                                                             "integer"),
+        ("shearwarp", {"planes_per_slice": True}, TypeError, "planes_per_slice must be an "
+                                                              "integer"),
         ("shear3", {"min_opacity": 0.1}, TypeError, "method 'shear3' takes no option"),
         ("shear2", {"filter": ("gaussian", 0.5, 6.0)}, ValueError, "radius 6 is out of range"),
     ],

@@ -6,7 +6,10 @@ the view becomes a projection along that axis, each resampled in 2-D with the ch
 composited front to back into an intermediate image at the front slice's resolution; the
 intermediate image is then warped to the final one with bilinear interpolation. Runs of
 transparent voxels are skipped (:func:`vrlib.skipping.transparent_runs`), Lacroute's
-run-length encoding. Transfer functions that need gradients (shading, gradient opacity) take the
+run-length encoding. With ``planes_per_slice`` above 1, sample planes between the slices
+interpolate them linearly, for a smaller error along rays at a proportional cost (the method's
+only knob of time against error: its in-slice resampling is the filter's own). Transfer
+functions that need gradients (shading, gradient opacity) take the
 samples' central differences resampled with the same weights (:mod:`vrlib.gradients`); a
 perspective view shades each intermediate pixel's samples along its own ray.
 :func:`vrlib.classify` is VolPack's form of the method, with classification and shading before
@@ -33,10 +36,33 @@ from vrlib.value_bounds import lattice_sums, reconstructed_range
 from vrlib.view import principal_axis
 
 __all__ = ["render_shearwarp", "project_shearwarp", "transparent_bound", "intermediate_plane",
-           "warp_homography", "warp"]
+           "sample_planes", "warp_homography", "warp", "MAX_PLANES_PER_SLICE"]
 
 #: Final-image rows per unit of the warp's parallel work.
 WARP_BAND = 16
+#: The most sample planes per slice spacing shear-warp takes (``planes_per_slice``).
+MAX_PLANES_PER_SLICE = 64
+
+
+def sample_planes(n_k, ascending, planes):
+    """Shear-warp's sample planes, front to back, for ``n_k`` slices and ``planes`` planes
+    per slice spacing: ``(order, other, between)``, plane ``p`` lying ``between[p]`` of the
+    way from slice ``order[p]`` to slice ``other[p]`` (0: the slice itself).
+
+    Examples
+    --------
+    >>> order, other, between = sample_planes(3, False, 2)
+    >>> order.tolist(), other.tolist(), between.tolist()
+    ([2, 2, 1, 1, 0], [2, 1, 1, 0, 0], [0.0, 0.5, 0.0, 0.5, 0.0])
+    """
+    slices = np.arange(n_k) if ascending else np.arange(n_k)[::-1].copy()
+    if planes == 1:
+        return slices, slices, np.zeros(n_k)
+    order = np.repeat(slices, planes)[: (n_k - 1) * planes + 1]
+    other = np.append(np.repeat(slices[1:], planes), slices[-1])
+    other[::planes] = slices  # the slices themselves
+    between = np.tile(np.arange(planes) / planes, n_k)[: (n_k - 1) * planes + 1]
+    return order, other, between
 
 
 def transparent_bound(transfer, low, high, length, min_opacity):
@@ -59,17 +85,21 @@ def transparent_bound(transfer, low, high, length, min_opacity):
     return float(start + (visible[0] - 1) / inv)
 
 
-def intermediate_plane(volume, view, axis, ascending):
-    """Shear-warp's factorisation: the plane of the front slice and, per slice, the map from
+def intermediate_plane(volume, view, axis, ascending, positions=None):
+    """Shear-warp's factorisation: the plane of the front slice and, per slice (or per
+    sample plane at ``positions``, slice indices that may lie between slices), the map from
     intermediate pixels to slice samples (:func:`vrlib._kernels.shear.shear_slices`).
 
-    Returns ``scale, di, dj`` (per slice), the offsets ``oi, oj`` and size ``(height, width)``
-    of the intermediate image, the front slice ``kf``, and ``rays(points)``: the direction in
-    index units of the ray through plane points (index units, ``[..., (i, j)]``)."""
+    Returns ``scale, di, dj`` (per slice or position), the offsets ``oi, oj`` and size
+    ``(height, width)`` of the intermediate image, the front slice ``kf``, and
+    ``rays(points)``: the direction in index units of the ray through plane points (index
+    units, ``[..., (i, j)]``)."""
     q_axis, p_axis = [a for a in range(3) if a != axis]  # columns i, rows j (Volume.slices)
     axes = [q_axis, p_axis, axis]
     n = [volume.shape[2 - a] for a in axes]  # (n_i, n_j, n_k)
     kf = 0 if ascending else n[2] - 1
+    if positions is None:
+        positions = np.arange(n[2], dtype=float)
     if not view.is_perspective:
         # In plain floats (a frame of VolPack's example: numpy's calls on vectors this short
         # cost more than their arithmetic), the same operations as on arrays.
@@ -79,8 +109,8 @@ def intermediate_plane(volume, view, axis, ascending):
         # sample = plane point + slope (k - kf): where the end slices land.
         low, size = _covering([(t * (0.0 - kf), t * (n[2] - 1.0 - kf)) for t in slope],
                               1.0, 1.0, n)
-        scale = np.ones(n[2])
-        offsets = np.arange(n[2], dtype=float) - kf
+        scale = np.ones(len(positions))
+        offsets = positions - kf
         di, dj = (t * offsets + start for t, start in zip(slope, low, strict=True))
 
         def rays(points):
@@ -93,11 +123,13 @@ def intermediate_plane(volume, view, axis, ascending):
                 f"perspective shear-warp needs the eye outside the volume's slab along its "
                 f"principal axis {name}: the eye is at {name} index {eye[2]:.3g}, the slab spans "
                 f"[0, {n[2] - 1}]; move the eye out or use method='raycast'")
-        k = np.arange(n[2], dtype=float)
-        scale = (k - eye[2]) / (kf - eye[2])  # >= 1: slices behind the front one shrink
+        ends = (np.array([0.0, n[2] - 1.0]) - eye[2]) / (kf - eye[2])
+        scale = (positions - eye[2]) / (kf - eye[2])  # >= 1: slices behind the front shrink
         shift = eye[:2, None] * (1.0 - scale)  # sample = scale * plane point + shift
-        low, size = _covering(zip(shift[:, 0].tolist(), shift[:, -1].tolist(), strict=True),
-                              float(scale[0]), float(scale[-1]), n)
+        end_shift = eye[:2, None] * (1.0 - ends)  # the end slices' (the image covers both)
+        low, size = _covering(
+            zip(end_shift[:, 0].tolist(), end_shift[:, -1].tolist(), strict=True),
+            float(ends[0]), float(ends[-1]), n)
         di, dj = shift + scale * np.array(low)[:, None]  # sample = scale * I + d
 
         def rays(points):
@@ -208,7 +240,7 @@ def warp(inter, homography, out, grey=False, *, threads=None):
 
 
 def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
-                     empty_space_skipping, min_opacity=0.0):
+                     empty_space_skipping, min_opacity=0.0, planes_per_slice=1):
     """Shear-warp rendering (Lacroute and Levoy 1994; arguments validated by
     :func:`vrlib.render`).
 
@@ -217,7 +249,8 @@ def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
     resampled with the chosen filter (in 2-D), composited front to back into an intermediate
     image at the front slice's resolution, and the intermediate image is warped to the final
     one with bilinear interpolation. ``step`` is unused: the samples along a ray are the
-    slices. Perspective views need the eye outside the volume's slab along that axis.
+    slices, and with ``planes_per_slice`` the planes between them. Perspective views need
+    the eye outside the volume's slab along that axis.
 
     Parameters
     ----------
@@ -226,9 +259,33 @@ def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
         0 skips only voxels that add nothing (exact), larger values skip faint voxels too
         (lossy, as VolPack's threshold). Skipping is on with ``empty_space_skipping`` and for
         filters without negative lobes.
+    planes_per_slice : int, default 1
+        Sample planes per slice spacing, from 1 to :data:`MAX_PLANES_PER_SLICE`: 1
+        composites the slices themselves; ``m`` adds ``m - 1`` planes between each two
+        slices, each interpolated linearly between them (the tent filter across slices,
+        whatever the filter in them: with the trilinear filter the samples of its field
+        exactly), each a segment of ``1/m`` of the path between slices. The error along
+        rays falls as with a ray caster's step of ``1/m`` of the slice spacing, the cost
+        grows about ``m`` times; the warp's bilinear interpolation of the intermediate image
+        stays as it is.
+
+    Examples
+    --------
+    >>> import data_gen, vrlib
+    >>> vol = data_gen.make_field("marschner-lobb").sample(17)
+    >>> view = vrlib.View.orbit(size=24, azimuth=30, elevation=20)
+    >>> exact = vrlib.render_reference(vrlib.ReconstructedField(vol), view,
+    ...                                transfer=vrlib.Glow(1.0))  # the trilinear field's
+    >>> [round(vrlib.metrics.rmse(vrlib.render(vol, view, method="shearwarp",
+    ...                                        planes_per_slice=m), exact), 4) for m in (1, 4)]
+    [0.0125, 0.0075]
     """
     min_opacity = validate.finite_number("min_opacity", min_opacity, low=0.0, high=1.0,
                                           high_open=True)
+    planes = validate.positive_int("planes_per_slice", planes_per_slice)
+    if planes > MAX_PLANES_PER_SLICE:
+        raise ValueError(f"planes_per_slice must be an integer from 1 to "
+                         f"{MAX_PLANES_PER_SLICE}, got {planes}")
     ntaps = filt.taps
     start = time.perf_counter()
     axis, ascending = principal_axis(view, volume)
@@ -237,13 +294,14 @@ def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
     # across, so their own samples are composited).
     in_slice = [a for a in range(3) if a != axis]
     samples, volume = volume, prepared(volume, filt, tally, axes=in_slice)
-    scale, di, dj, (oi, oj), (height, width), kf, rays = intermediate_plane(
-        volume, view, axis, ascending)
     q_axis, p_axis = [a for a in range(3) if a != axis]
     slices = volume.slices(axis)  # [k, j, i]: j along p_axis, i along q_axis
     n_k = slices.shape[0]
     h = volume.spacing
-    order = np.arange(n_k) if ascending else np.arange(n_k)[::-1].copy()
+    order, other, between = sample_planes(n_k, ascending, planes)
+    positions = order + between * (other - order)
+    scale, di, dj, (oi, oj), (height, width), kf, rays = intermediate_plane(
+        volume, view, axis, ascending, positions)
 
     def segment(direction):  # world distance between slices along rays of these directions
         world = direction * h[[q_axis, p_axis, axis]]
@@ -266,7 +324,7 @@ def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
                 directions[..., a] = rays(grid)[..., column] * h[a]
             directions /= np.linalg.norm(directions, axis=-1, keepdims=True)
     low, high = reconstructed_range(volume, filt)
-    tables = transfer.segment_table(length, low, high)
+    tables = transfer.segment_table(length / planes if planes > 1 else length, low, high)
     bound = -math.inf
     if empty_space_skipping and lattice_sums(filt)[2] <= 1.0 + 1e-6:
         bound = transparent_bound(transfer, low, high, length, min_opacity)
@@ -277,7 +335,8 @@ def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
     if transfer.needs_gradient:  # the gradient's components in slice order, like ``slices``
         grads = prepared_gradients(samples, filt, tally, in_slice).transpose(
             {2: (0, 1, 2, 3), 1: (0, 2, 1, 3), 0: (0, 3, 1, 2)}[axis])
-    _kernel.shear_slices(slices, order, scale, di, dj, fraction, *filt.code, filt.radius,
+    _kernel.shear_slices(slices, order, other, between, scale, di, dj, fraction, *filt.code,
+                         filt.radius,
                          ntaps, *tables, grads, *kernel_lighting(transfer, view.forward),
                          readonly(np.ascontiguousarray(directions, np.float64)),
                          early_termination,
@@ -288,7 +347,9 @@ def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
     grey = bool(np.all(tables[4] == 1.0))  # white emission: red, green and blue are equal
     warp(inter, warp_homography(view, volume, axis, plane, (oi, oj)), out, grey)
     resampled = int(counts.sum())
-    stats = RenderStats(samples=resampled, operations=resampled * (2 * ntaps**2 + 12)
+    # A plane between two slices resamples both (the others' share of the planes: 1 / m).
+    sums = 2.0 - 1.0 / planes
+    stats = RenderStats(samples=resampled, operations=int(resampled * (2 * ntaps**2 * sums + 12))
                         + out.size * 8, bytes=int(volume.data.nbytes + inter.nbytes + out.nbytes),
                         seconds=time.perf_counter() - start, voxels=resampled)
     return Image(out, tally.finish(stats, filt), checked=False)  # the warp clipped it

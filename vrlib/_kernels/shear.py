@@ -388,21 +388,35 @@ def _slice_sum(slices, k, rows, i0, ntaps, wi, wj):
     return value
 
 
+@jit(inline="always")
+def _plane_sum(slices, k, k2, w, rows, i0, ntaps, wi, wj):
+    """:func:`_slice_sum` on the plane ``w`` of the way from slice ``k`` to slice ``k2``:
+    slice ``k`` itself where ``w`` is 0, else the two slices' sums interpolated linearly."""
+    if w == 0.0:
+        return _slice_sum(slices, k, rows, i0, ntaps, wi, wj)
+    return ((1.0 - w) * _slice_sum(slices, k, rows, i0, ntaps, wi, wj)
+            + w * _slice_sum(slices, k2, rows, i0, ntaps, wi, wj))
+
+
 @parallel_jit
-def shear_slices(slices, order, scale, di, dj, fraction, fkind, fp0, fp1, fp2, radius, ntaps,
-                 tstart, tinv, alpha_tab, color_tab, emit_tab, grads, lit, ramp_x, ramp_y,
-                 rays, threshold, first, last, inter, counts):
+def shear_slices(slices, order, other, between, scale, di, dj, fraction, fkind, fp0, fp1, fp2,
+                 radius, ntaps, tstart, tinv, alpha_tab, color_tab, emit_tab, grads, lit, ramp_x,
+                 ramp_y, rays, threshold, first, last, inter, counts):
     """Shear-warp's compositing into the intermediate image (Lacroute and Levoy 1994).
 
-    ``slices[k, j, i]`` is the volume in slice order. Intermediate pixel ``(I, J)`` samples
-    slice ``k`` at ``(i, j) = scale[k] (I, J) + (di[k], dj[k])``: a translation (orthographic,
-    ``scale = 1``: one fractional offset per slice, so one set of filter weights serves the
-    whole slice) or a translation and scale (perspective). Slices are taken in ``order`` (front
-    to back) and composited into ``inter[J, I]`` (premultiplied RGBA, zeros on entry), each a
-    segment of the table's length times ``fraction[J, I]`` (shape ``(1, 1)``: 1 everywhere),
-    halved on the first and last slice. Row ``j`` of slice ``k`` holds nothing visible outside
-    columns ``first[k, j] .. last[k, j]``; pixels whose opacity has reached ``threshold`` take
-    no more. Each task owns intermediate rows: no races. With ``grads`` (``[3, k, j, i]``, the
+    ``slices[k, j, i]`` is the volume in slice order. The sample planes are taken front to
+    back: plane ``p`` lies ``between[p]`` of the way from slice ``order[p]`` to slice
+    ``other[p]`` (0: the slice itself; planes between two slices interpolate them linearly,
+    the tent filter across slices). Intermediate pixel ``(I, J)`` samples plane ``p`` at
+    ``(i, j) = scale[p] (I, J) + (di[p], dj[p])``: a translation (orthographic, ``scale =
+    1``: one fractional offset per plane, so one set of filter weights serves the whole
+    plane) or a translation and scale (perspective). Each plane is composited into
+    ``inter[J, I]`` (premultiplied RGBA, zeros on entry) as a segment of the table's length
+    times ``fraction[J, I]`` (shape ``(1, 1)``: 1 everywhere), halved on the volume's end
+    slices. Row ``j`` of slice ``k`` holds nothing visible outside columns ``first[k, j] ..
+    last[k, j]`` (a plane between two slices, nothing outside the union of theirs: the
+    filter has no negative lobes where runs are skipped); pixels whose opacity has reached
+    ``threshold`` take no more. Each task owns intermediate rows: no races. With ``grads`` (``[3, k, j, i]``, the
     gradient's components in slice order; ``no_gradients()`` for none) each sample's gradient is
     resampled with the same weights and the sample classified by it too (:func:`_over_lit`),
     seen along ``rays[J, I]`` (world unit directions, shape ``(1, 1, 3)``: the view's one
@@ -421,14 +435,15 @@ def shear_slices(slices, order, scale, di, dj, fraction, fkind, fp0, fp1, fp2, r
         wj = np.empty(8)
         rows = np.empty(8, np.int64)
         done = 0
-        for step in range(n_k):
-            k = order[step]
-            s = scale[k]
-            j = s * big_j + dj[k]
+        for p in range(order.shape[0]):
+            k, k2, w = order[p], other[p], between[p]
+            s = scale[p]
+            j = s * big_j + dj[p]
             if j < 0.0 or j > n_j - 1:
                 continue
             j_first = int(math.floor(j - radius)) + 1
-            # Columns this row can draw: the union of the tap rows' visible runs, widened.
+            # Columns this row can draw: the union of the tap rows' visible runs (of both
+            # slices, on a plane between two), widened.
             lo = n_i
             hi = -1
             for b in range(ntaps):
@@ -437,41 +452,44 @@ def shear_slices(slices, order, scale, di, dj, fraction, fkind, fp0, fp1, fp2, r
                 if first[k, rows[b]] <= last[k, rows[b]]:
                     lo = min(lo, first[k, rows[b]])
                     hi = max(hi, last[k, rows[b]])
+                if w != 0.0 and first[k2, rows[b]] <= last[k2, rows[b]]:
+                    lo = min(lo, first[k2, rows[b]])
+                    hi = max(hi, last[k2, rows[b]])
             if lo > hi:
                 continue
             i_lo = max(0.0, lo - radius)
             i_hi = min(n_i - 1.0, hi + radius)
-            big_first = max(0, int(math.ceil((i_lo - di[k]) / s)))
-            big_last = min(width - 1, int(math.floor((i_hi - di[k]) / s)))
+            big_first = max(0, int(math.ceil((i_lo - di[p]) / s)))
+            big_last = min(width - 1, int(math.floor((i_hi - di[p]) / s)))
             shared = s == 1.0
-            tap0 = int(math.floor(di[k] - radius)) + 1  # orthographic: first tap - I
+            tap0 = int(math.floor(di[p] - radius)) + 1  # orthographic: first tap - I
             if shared:
                 for a in range(ntaps):
-                    wi[a] = weight(fkind, fp0, fp1, fp2, di[k] - (tap0 + a))
-            end = 0.5 if k == 0 or k == n_k - 1 else 1.0
+                    wi[a] = weight(fkind, fp0, fp1, fp2, di[p] - (tap0 + a))
+            end = 0.5 if w == 0.0 and (k == 0 or k == n_k - 1) else 1.0
             for big_i in range(big_first, big_last + 1):
                 if inter[big_j, big_i, 3] >= threshold:
                     continue
                 if shared:
                     i0 = big_i + tap0
                 else:
-                    i = s * big_i + di[k]
+                    i = s * big_i + di[p]
                     i0 = int(math.floor(i - radius)) + 1
                     for a in range(ntaps):
                         wi[a] = weight(fkind, fp0, fp1, fp2, i - (i0 + a))
-                value = _slice_sum(slices, k, borrowed(rows), i0, ntaps, borrowed(wi),
+                value = _plane_sum(slices, k, k2, w, borrowed(rows), i0, ntaps, borrowed(wi),
                                    borrowed(wj))
                 done += 1
                 part = end if uniform else end * fraction[big_j, big_i]
                 if lighting:
                     # Perspective: each intermediate pixel's own ray direction.
                     ray_j, ray_i = (0, 0) if rays.shape[0] == 1 else (big_j, big_i)
-                    _over_lit(value, part, _slice_sum(grads[0], k, borrowed(rows), i0, ntaps,
-                                                      borrowed(wi), borrowed(wj)),
-                              _slice_sum(grads[1], k, borrowed(rows), i0, ntaps, borrowed(wi),
-                                         borrowed(wj)),
-                              _slice_sum(grads[2], k, borrowed(rows), i0, ntaps, borrowed(wi),
-                                         borrowed(wj)), tstart, tinv,
+                    _over_lit(value, part, _plane_sum(grads[0], k, k2, w, borrowed(rows), i0,
+                                                      ntaps, borrowed(wi), borrowed(wj)),
+                              _plane_sum(grads[1], k, k2, w, borrowed(rows), i0, ntaps,
+                                         borrowed(wi), borrowed(wj)),
+                              _plane_sum(grads[2], k, k2, w, borrowed(rows), i0, ntaps,
+                                         borrowed(wi), borrowed(wj)), tstart, tinv,
                               alpha_tab, emit_tab, lit, ramp_x, ramp_y, inter, big_j, big_i,
                               rays[ray_j, ray_i, 0], rays[ray_j, ray_i, 1],
                               rays[ray_j, ray_i, 2])
