@@ -625,7 +625,8 @@ def warp_naive(inter, volume, view, axis, q_axis, p_axis, kf, low):
     return np.clip(out, 0.0, 1.0)
 
 
-def shearwarp_naive(volume, view, filt, transfer, blend=None, planes=1):
+def shearwarp_naive(volume, view, filt, transfer, blend=None, planes=1,
+                    segment_ends="lattice"):
     """Shear-warp by the book: the intermediate image lies on the front slice's plane at its
     resolution; each of its pixels follows its ray (parallel, or from the eye) through every
     slice, resamples the slice where the ray meets it with the 2-D filter and composites front
@@ -633,7 +634,10 @@ def shearwarp_naive(volume, view, filt, transfer, blend=None, planes=1):
     then the intermediate image is sampled bilinearly where each pixel's ray meets the plane.
     With ``planes`` > 1 the ray also meets ``planes - 1`` planes evenly between each two
     slices, where it samples both slices (at the same in-slice point) and interpolates them
-    linearly, each segment ``1 / planes`` of the path between slices.
+    linearly, each segment ``1 / planes`` of the path between slices. With
+    ``segment_ends="exact"`` each plane's segment is cut to the stretch of the ray inside the
+    volume (found from where the ray meets the first and last slice), and a segment so cut
+    is sampled at the middle of its part inside, interpolated between the slices about it.
     With ``blend`` ("maximum" or "average") a pixel takes the largest or the mean of its
     values instead, classified with the transfer function's unit distance, before the warp."""
     from vrlib.view import principal_axis
@@ -686,16 +690,41 @@ def shearwarp_naive(volume, view, filt, transfer, blend=None, planes=1):
             point = np.array([big_i, big_j], float) + low
             values = []
             positions = np.arange(0, n_k - 1 + 0.5 / planes, 1.0 / planes)
+            k_lo, k_hi = 0.0, n_k - 1.0  # the ray's stretch inside, in slice coordinates
+            (i_a, j_a), _ = hit(point, 0.0)
+            (i_b, j_b), _ = hit(point, n_k - 1.0)
+            for at_first, at_last, limit in ((i_a, i_b, n_i - 1), (j_a, j_b, n_j - 1)):
+                if at_first == at_last:
+                    if not 0 <= at_first <= limit:
+                        k_lo, k_hi = 1.0, 0.0
+                    continue
+                a, b = sorted(((0 - at_first) / (at_last - at_first),
+                               (limit - at_first) / (at_last - at_first)))
+                k_lo, k_hi = max(k_lo, a * (n_k - 1)), min(k_hi, b * (n_k - 1))
+            # Within rounding of an end slice: on it (its half segment sampled on it).
+            k_lo = 0.0 if k_lo <= 1e-9 else k_lo
+            k_hi = n_k - 1.0 if k_hi >= n_k - 1 - 1e-9 else k_hi
             for k in (positions if ascending else positions[::-1]):
+                part = 0.5 if k in (0, n_k - 1) else 1.0  # end slices reach half as far
+                if segment_ends == "exact":
+                    lo = max(k - 0.5 / planes, 0.0)
+                    hi = min(k + 0.5 / planes, n_k - 1.0)
+                    cut_lo, cut_hi = max(lo, k_lo), min(hi, k_hi)
+                    if not cut_hi > cut_lo:
+                        continue
+                    if (cut_lo, cut_hi) != (lo, hi):  # cut by a side face: its middle
+                        k, part = 0.5 * (cut_lo + cut_hi), (cut_hi - cut_lo) * planes
                 (i, j), length = hit(point, k)
                 length /= planes
+                if segment_ends == "exact":
+                    i, j = min(max(i, 0.0), n_i - 1.0), min(max(j, 0.0), n_j - 1.0)
                 if not (0 <= i <= n_i - 1 and 0 <= j <= n_j - 1):
                     continue
                 jdx = math.floor(j - filt.radius) + 1 + np.arange(taps)
                 idx = math.floor(i - filt.radius) + 1 + np.arange(taps)
                 taps_at = np.ix_(np.clip(jdx, 0, n_j - 1), np.clip(idx, 0, n_i - 1))
-                k0 = min(int(math.floor(k)), n_k - 1)
-                k1, w = min(k0 + 1, n_k - 1), k - k0  # the slices about the plane
+                k0 = min(int(math.floor(k)), n_k - 2)
+                k1, w = k0 + 1, k - k0  # the slices about the plane
 
                 def across(stack, k0=k0, k1=k1, w=w, taps_at=taps_at, i=i, j=j, idx=idx,
                            jdx=jdx):  # the 2-D filter on both slices, linear between
@@ -706,7 +735,6 @@ def shearwarp_naive(volume, view, filt, transfer, blend=None, planes=1):
                 if blend is not None:
                     values.append(value)
                     continue
-                part = 0.5 if k in (0, n_k - 1) else 1.0  # end slices reach half as far
                 density = transfer.opacity_density(np.array([value]))[0]
                 colour = transfer.emission(np.array([value]))[0]
                 if gradients is not None:

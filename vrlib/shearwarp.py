@@ -36,12 +36,74 @@ from vrlib.value_bounds import lattice_sums, reconstructed_range
 from vrlib.view import principal_axis
 
 __all__ = ["render_shearwarp", "project_shearwarp", "transparent_bound", "intermediate_plane",
-           "sample_planes", "warp_homography", "warp", "MAX_PLANES_PER_SLICE"]
+           "sample_planes", "ray_stretches", "whole_planes", "warp_homography", "warp",
+           "MAX_PLANES_PER_SLICE", "SEGMENT_ENDS"]
 
 #: Final-image rows per unit of the warp's parallel work.
 WARP_BAND = 16
 #: The most sample planes per slice spacing shear-warp takes (``planes_per_slice``).
 MAX_PLANES_PER_SLICE = 64
+#: How shear-warp counts the segments that the volume's side faces cut (``segment_ends``).
+SEGMENT_ENDS = ("lattice", "exact")
+#: Slice coordinates within this of an end slice count as on it (:func:`whole_planes`): the
+#: intermediate image's pixels lie on the front slice's lattice, so rays through its edge
+#: meet the side faces there, at 0 or a rounding from it.
+SLAB_EDGE = 1e-9
+
+
+def ray_stretches(ends, shape, slice_shape):
+    """Where each intermediate pixel's ray lies inside the volume, in slice coordinates:
+    ``inside[J, I] = (k_lo, k_hi)`` within ``[0, n_k - 1]``, empty (``k_lo > k_hi``) where
+    the ray misses it. ``ends`` holds ``(scale, di, dj)`` (rows) on the first and last
+    slice (columns); the ray meets slice coordinate ``k`` at ``(i, j) = s (I, J) + (di, dj)``
+    with all three linear in ``k`` (:func:`intermediate_plane`), ``slice_shape`` is ``(n_k,
+    n_j, n_i)``.
+
+    Examples
+    --------
+    >>> ends = np.array([[1.0, 1.0], [-2.0, 2.0], [0.0, 0.0]])  # i = I - 2 + k
+    >>> ray_stretches(ends, (1, 3), (5, 1, 3))[0].tolist()   # inside for 0 <= i <= 2
+    [[2.0, 4.0], [1.0, 3.0], [0.0, 2.0]]
+    """
+    n_k, n_j, n_i = slice_shape
+    height, width = shape
+    columns, rows = np.meshgrid(np.arange(width, dtype=float), np.arange(height, dtype=float))
+    t_lo, t_hi = np.zeros(shape), np.ones(shape)
+    for grid, d, limit in ((columns, ends[1], n_i - 1.0), (rows, ends[2], n_j - 1.0)):
+        at_first, at_last = ends[0, 0] * grid + d[0], ends[0, 1] * grid + d[1]
+        change = at_last - at_first
+        moving = change != 0.0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            a = np.where(moving, (0.0 - at_first) / change, -np.inf)
+            b = np.where(moving, (limit - at_first) / change, np.inf)
+        still_outside = ~moving & ((at_first < 0.0) | (at_first > limit))
+        t_lo = np.maximum(t_lo, np.where(still_outside, np.inf, np.minimum(a, b)))
+        t_hi = np.minimum(t_hi, np.where(still_outside, -np.inf, np.maximum(a, b)))
+    return np.stack([t_lo * (n_k - 1.0), t_hi * (n_k - 1.0)], axis=-1)
+
+
+def whole_planes(inside, n_k, planes):
+    """The first and last plane (on the planes' lattice from slice 0, ``1 / planes`` apart)
+    whose whole segment, ``[q h - h/2, q h + h/2]`` cut to ``[0, n_k - 1]``, lies in each
+    pixel's stretch ``inside`` (:func:`ray_stretches`); first > last where none does.
+
+    Examples
+    --------
+    >>> inside = np.array([[[0.0, 4.0], [0.3, 2.6], [1.2, 1.4]]])
+    >>> [a.tolist() for a in whole_planes(inside, 5, 1)]
+    [[[0, 1, 2]], [[4, 2, 0]]]
+    """
+    k_lo, k_hi = inside[..., 0], inside[..., 1]
+    last = (n_k - 1) * planes
+    # A ray that meets an end slice within rounding of its edge takes that slice's half
+    # segment, sampled on the slice, as every ray through the end slices does (the middle
+    # of a cut part would lie a quarter segment in: not a rounding's worth).
+    first = np.where(k_lo <= SLAB_EDGE, 0, np.ceil(k_lo * planes + 0.5))
+    final = np.where(k_hi >= n_k - 1.0 - SLAB_EDGE, last, np.floor(k_hi * planes - 0.5))
+    missed = ~(k_lo <= k_hi)
+    first = np.where(missed, 1, first).astype(np.int64)
+    final = np.where(missed, 0, final).astype(np.int64)
+    return first, final
 
 
 def sample_planes(n_k, ascending, planes):
@@ -240,7 +302,8 @@ def warp(inter, homography, out, grey=False, *, threads=None):
 
 
 def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
-                     empty_space_skipping, min_opacity=0.0, planes_per_slice=1):
+                     empty_space_skipping, min_opacity=0.0, planes_per_slice=1,
+                     segment_ends="lattice"):
     """Shear-warp rendering (Lacroute and Levoy 1994; arguments validated by
     :func:`vrlib.render`).
 
@@ -268,6 +331,14 @@ def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
         rays falls as with a ray caster's step of ``1/m`` of the slice spacing, the cost
         grows about ``m`` times; the warp's bilinear interpolation of the intermediate image
         stays as it is.
+    segment_ends : {"lattice", "exact"}, default "lattice"
+        Where a ray enters or leaves the volume through a side face (one that does not lie
+        in a slice's plane), ``"lattice"`` lets each plane inside stand for its whole
+        segment, and one outside for none: an error of first order in the planes' spacing
+        wherever the field is not zero at those faces. ``"exact"`` counts only the part of
+        each segment inside the volume, sampled at its middle (the two slices about it
+        interpolated linearly), as the ray caster's ``segment_ends="exact"`` does: second
+        order. The end slices reach half a segment into the volume either way.
 
     Examples
     --------
@@ -282,6 +353,7 @@ def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
     """
     min_opacity = validate.finite_number("min_opacity", min_opacity, low=0.0, high=1.0,
                                           high_open=True)
+    exact = validate.choice("segment_ends", segment_ends, SEGMENT_ENDS) == "exact"
     planes = validate.positive_int("planes_per_slice", planes_per_slice)
     if planes > MAX_PLANES_PER_SLICE:
         raise ValueError(f"planes_per_slice must be an integer from 1 to "
@@ -335,12 +407,23 @@ def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
     if transfer.needs_gradient:  # the gradient's components in slice order, like ``slices``
         grads = prepared_gradients(samples, filt, tally, in_slice).transpose(
             {2: (0, 1, 2, 3), 1: (0, 2, 1, 3), 0: (0, 3, 1, 2)}[axis])
+    lattice = np.rint(positions * planes).astype(np.int64)  # each plane's, from slice 0
+    full_first = full_last = np.zeros((1, 1), np.int64)  # lattice ends: every plane
+    if exact:
+        ends = np.array(intermediate_plane(volume, view, axis, ascending,
+                                           np.array([0.0, n_k - 1.0]))[:3])
+        inside = ray_stretches(ends, (height, width), slices.shape)
+        full_first, full_last = whole_planes(inside, n_k, planes)
+    lighting = kernel_lighting(transfer, view.forward)
+    directions = readonly(np.ascontiguousarray(directions, np.float64))
     _kernel.shear_slices(slices, order, other, between, scale, di, dj, fraction, *filt.code,
-                         filt.radius,
-                         ntaps, *tables, grads, *kernel_lighting(transfer, view.forward),
-                         readonly(np.ascontiguousarray(directions, np.float64)),
-                         early_termination,
-                         readonly(first), readonly(last), inter, counts)
+                         filt.radius, ntaps, *tables, grads, *lighting, directions,
+                         early_termination, readonly(first), readonly(last), inter, counts,
+                         lattice, full_first, full_last)
+    if exact:
+        _kernel.shear_cut_ends(slices, planes, ascending, ends, fraction, *filt.code,
+                               filt.radius, ntaps, *tables, grads, *lighting, directions,
+                               inside, full_first, full_last, inter, counts)
     # The warp: where each pixel's ray meets the front slice, in intermediate coordinates.
     plane = volume.origin[axis] + kf * h[axis]
     out = np.empty(view.shape + (4,))

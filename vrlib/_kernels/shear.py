@@ -401,7 +401,8 @@ def _plane_sum(slices, k, k2, w, rows, i0, ntaps, wi, wj):
 @parallel_jit
 def shear_slices(slices, order, other, between, scale, di, dj, fraction, fkind, fp0, fp1, fp2,
                  radius, ntaps, tstart, tinv, alpha_tab, color_tab, emit_tab, grads, lit, ramp_x,
-                 ramp_y, rays, threshold, first, last, inter, counts):
+                 ramp_y, rays, threshold, first, last, inter, counts, lattice, full_first,
+                 full_last):
     """Shear-warp's compositing into the intermediate image (Lacroute and Levoy 1994).
 
     ``slices[k, j, i]`` is the volume in slice order. The sample planes are taken front to
@@ -416,7 +417,11 @@ def shear_slices(slices, order, other, between, scale, di, dj, fraction, fkind, 
     slices. Row ``j`` of slice ``k`` holds nothing visible outside columns ``first[k, j] ..
     last[k, j]`` (a plane between two slices, nothing outside the union of theirs: the
     filter has no negative lobes where runs are skipped); pixels whose opacity has reached
-    ``threshold`` take no more. Each task owns intermediate rows: no races. With ``grads`` (``[3, k, j, i]``, the
+    ``threshold`` take no more. With exact segment ends (``full_first`` of shape
+    ``inter.shape[:2]``; ``(1, 1)`` for none), pixel ``(I, J)`` takes plane ``p`` only where
+    ``full_first[J, I] <= lattice[p] <= full_last[J, I]`` (``lattice[p]``: the plane's place
+    on the planes' lattice, from slice 0): the planes whose whole segment lies inside the
+    volume; :func:`shear_cut_ends` adds the parts of the others. Each task owns intermediate rows: no races. With ``grads`` (``[3, k, j, i]``, the
     gradient's components in slice order; ``no_gradients()`` for none) each sample's gradient is
     resampled with the same weights and the sample classified by it too (:func:`_over_lit`),
     seen along ``rays[J, I]`` (world unit directions, shape ``(1, 1, 3)``: the view's one
@@ -426,6 +431,7 @@ def shear_slices(slices, order, other, between, scale, di, dj, fraction, fkind, 
     n_k, n_j, n_i = slices.shape
     height, width = inter.shape[0], inter.shape[1]
     uniform = fraction.shape[0] == 1
+    exact = full_first.shape[0] > 1
     alpha_tab, emit_tab, lit, ramp_x, ramp_y, inter = _lit_views(alpha_tab, emit_tab, lit,
                                                                  ramp_x, ramp_y, inter)
     slices, grads = borrowed(slices), borrowed(grads)
@@ -470,6 +476,9 @@ def shear_slices(slices, order, other, between, scale, di, dj, fraction, fkind, 
             for big_i in range(big_first, big_last + 1):
                 if inter[big_j, big_i, 3] >= threshold:
                     continue
+                if exact and not (full_first[big_j, big_i] <= lattice[p]
+                                  <= full_last[big_j, big_i]):
+                    continue  # a segment the volume's faces cut: shear_cut_ends
                 if shared:
                     i0 = big_i + tap0
                 else:
@@ -496,6 +505,107 @@ def shear_slices(slices, order, other, between, scale, di, dj, fraction, fkind, 
                 else:
                     _over(value, part, tstart, tinv, alpha_tab, color_tab, inter, big_j, big_i)
         counts[big_j] = done
+
+
+@parallel_jit
+def shear_cut_ends(slices, planes, ascending, ends, fraction, fkind, fp0, fp1, fp2, radius,
+                   ntaps, tstart, tinv, alpha_tab, color_tab, emit_tab, grads, lit, ramp_x,
+                   ramp_y, rays, inside, full_first, full_last, inter, counts):
+    """Shear-warp's exact segment ends: the parts inside the volume of the segments that its
+    side faces cut, composited in front of and behind what :func:`shear_slices` composited
+    into ``inter`` (the operator is associative: the same image as in order, but for
+    rounding and for early termination, which :func:`shear_slices` decides without the front
+    part).
+
+    The planes lie ``1 / planes`` apart from slice 0; plane ``q``'s segment is ``[q h - h/2,
+    q h + h/2]`` in slice coordinates, cut to ``[0, n_k - 1]`` (the end slices' halves).
+    Pixel ``(I, J)``'s ray lies inside the volume for slice coordinates ``inside[J, I] =
+    (k_lo, k_hi)`` (empty: ``k_lo > k_hi``), and at ``(i, j) = s (I, J) + (di, dj)`` on slice
+    coordinate ``k``, where ``ends[:, 0]`` and ``ends[:, 1]`` are ``(s, di, dj)`` on the
+    first and last slice and all three are linear in ``k``. The planes ``full_first ..
+    full_last`` lie wholly inside; the part of the ray inside before the first of them (or
+    the parts of the one or two segments it meets, where none is) and after the last are
+    each one segment's part, sampled at its middle (the two slices about it interpolated linearly, as a plane between them), of
+    length over ``h`` times ``fraction[J, I]`` (perspective) the table's."""
+    lighting = lit[0] != 0.0 or lit[2] != 0.0
+    n_k, n_j, n_i = slices.shape
+    height, width = inter.shape[0], inter.shape[1]
+    h = 1.0 / planes
+    last = (n_k - 1) * planes
+    alpha_tab, emit_tab, lit, ramp_x, ramp_y, inter = _lit_views(alpha_tab, emit_tab, lit,
+                                                                 ramp_x, ramp_y, inter)
+    slices, grads = borrowed(slices), borrowed(grads)
+    for row in prange(height):
+        big_j = np.int64(row)
+        wi = np.empty(8)
+        wj = np.empty(8)
+        rows = np.empty(8, np.int64)
+        part = np.zeros((1, 1, 4))
+        done = 0
+        for big_i in range(width):
+            k_lo, k_hi = inside[big_j, big_i, 0], inside[big_j, big_i, 1]
+            if k_lo > k_hi:
+                continue
+            q_a, q_b = full_first[big_j, big_i], full_last[big_j, big_i]
+            # Where the low part ends and the high one starts: none beside an end slice
+            # whose half segment is whole (whole_planes); with no plane wholly inside, the
+            # end of the segment that holds k_lo (the stretch meets two at most).
+            low_end = k_lo if q_a == 0 else max(q_a * h - 0.5 * h, k_lo)
+            high_start = k_hi if q_b == last else min(q_b * h + 0.5 * h, k_hi)
+            if q_a > q_b:
+                low_end = high_start = min(
+                    math.floor(k_lo * planes + 0.5) * h + 0.5 * h, n_k - 1.0, k_hi)
+            for side in range(2):  # 0: the low end (slice 0's side), 1: the high end
+                a, b = (k_lo, low_end) if side == 0 else (high_start, k_hi)
+                if not b > a:
+                    continue
+                k = 0.5 * (a + b)
+                t = k / (n_k - 1.0)
+                s = ends[0, 0] + (ends[0, 1] - ends[0, 0]) * t
+                i = s * big_i + (ends[1, 0] + (ends[1, 1] - ends[1, 0]) * t)
+                j = s * big_j + (ends[2, 0] + (ends[2, 1] - ends[2, 0]) * t)
+                i = min(max(i, 0.0), n_i - 1.0)  # on the face, where rounding put it past
+                j = min(max(j, 0.0), n_j - 1.0)
+                j_first = int(math.floor(j - radius)) + 1
+                for c in range(ntaps):
+                    wj[c] = weight(fkind, fp0, fp1, fp2, j - (j_first + c))
+                    rows[c] = clamp(j_first + c, n_j)
+                i0 = int(math.floor(i - radius)) + 1
+                for c in range(ntaps):
+                    wi[c] = weight(fkind, fp0, fp1, fp2, i - (i0 + c))
+                k0 = min(int(math.floor(k)), n_k - 2)
+                w = k - k0
+                value = _plane_sum(slices, k0, k0 + 1, w, borrowed(rows), i0, ntaps,
+                                   borrowed(wi), borrowed(wj))
+                done += 1
+                length = (b - a) / h * (fraction[0, 0] if fraction.shape[0] == 1
+                                        else fraction[big_j, big_i])
+                part[0, 0, 0] = part[0, 0, 1] = part[0, 0, 2] = part[0, 0, 3] = 0.0
+                if lighting:
+                    ray_j, ray_i = (0, 0) if rays.shape[0] == 1 else (big_j, big_i)
+                    _over_lit(value, length, _plane_sum(grads[0], k0, k0 + 1, w,
+                                                        borrowed(rows), i0, ntaps,
+                                                        borrowed(wi), borrowed(wj)),
+                              _plane_sum(grads[1], k0, k0 + 1, w, borrowed(rows), i0, ntaps,
+                                         borrowed(wi), borrowed(wj)),
+                              _plane_sum(grads[2], k0, k0 + 1, w, borrowed(rows), i0, ntaps,
+                                         borrowed(wi), borrowed(wj)), tstart, tinv,
+                              alpha_tab, emit_tab, lit, ramp_x, ramp_y, part, 0, 0,
+                              rays[ray_j, ray_i, 0], rays[ray_j, ray_i, 1],
+                              rays[ray_j, ray_i, 2])
+                else:
+                    _over(value, length, tstart, tinv, alpha_tab, color_tab, part, 0, 0)
+                if (side == 0) == ascending:
+                    # In front: the part over what lies behind it.
+                    behind = 1.0 - part[0, 0, 3]
+                    for ch in range(4):
+                        inter[big_j, big_i, ch] = part[0, 0, ch] + behind * inter[big_j, big_i,
+                                                                                   ch]
+                else:  # behind: under what lies in front of it
+                    front = 1.0 - inter[big_j, big_i, 3]
+                    for ch in range(4):
+                        inter[big_j, big_i, ch] += front * part[0, 0, ch]
+        counts[big_j] += done
 
 
 @parallel_jit
