@@ -527,10 +527,29 @@ def shear_pass_naive(src, valid, out_shape, c0, c1, c2, offset, filt):
     return out, computed
 
 
-def shear_naive(volume, view, filt, transfer, step, passes):
+def line_at_naive(line, valid, pos, filt):
+    """One line of a pass resampled at ``pos`` by the book (:func:`shear_pass_naive`'s sum for
+    one output): 0 where the line holds no data within the filter's reach."""
+    where = np.flatnonzero(valid)
+    if where.size == 0:
+        return 0.0
+    lo, hi = where[0], where[-1]
+    if not lo - filt.radius <= pos <= hi + filt.radius:
+        return 0.0
+    line = line.copy()
+    line[lo:hi + 1] = prefilter_naive(line[lo:hi + 1], filt, (0,))
+    taps = max(1, math.ceil(2 * filt.radius))
+    idx = math.floor(pos - filt.radius) + 1 + np.arange(taps)
+    return float(np.sum(filt(pos - idx) * line[np.clip(idx, lo, hi)]))
+
+
+def shear_naive(volume, view, filt, transfer, step, passes, segment_ends="lattice"):
     """Three- (``passes=3``) or two-pass shear rendering with the kernels' plan, by the book:
     the passes above, then each pixel's samples composited in depth order, a sample counting
-    only where it maps back inside the volume."""
+    only where it maps back inside the volume. With ``segment_ends="exact"`` (three passes)
+    each depth sample ``z`` stands for ``[z - 1/2, z + 1/2]`` cut to the ray's stretch inside
+    the volume, and a segment so cut is sampled at the middle of its part inside (pass 3's
+    line resampled there), in order."""
     from vrlib.shear import plan_shear
 
     ds = step * float(volume.spacing.min())
@@ -552,6 +571,7 @@ def shear_naive(volume, view, filt, transfer, step, passes):
         v2, ok2 = shear_pass_naive(v1.transpose(0, 2, 1), ok1.transpose(0, 2, 1), (nw, wd, h),
                                    plan.e, plan.d, plan.f, plan.t1, filt)
         v2, ok2 = v2.transpose(0, 2, 1), ok2.transpose(0, 2, 1)
+        lines.append((v2.transpose(1, 2, 0), ok2.transpose(1, 2, 0)))  # [Y, X, w]
         if passes == 2:
             return v2
         v3, _ = shear_pass_naive(v2.transpose(1, 2, 0), ok2.transpose(1, 2, 0),
@@ -559,7 +579,12 @@ def shear_naive(volume, view, filt, transfer, step, passes):
                                  filt)
         return v3.transpose(2, 0, 1)
 
+    lines = []
     volumes = [resampled(channel) for channel in channels]
+    if segment_ends == "exact" and passes == 3:
+        return _shear3_exact_naive(view, transfer, filt, plan, channels, lines, volumes, ds)
+    if segment_ends == "exact":
+        return _shear2_exact_naive(view, transfer, plan, channels, volumes, ds)
     nw, nv, nu = np.transpose(field, (2 - w, 2 - v, 2 - u)).shape
     image = np.zeros(view.shape + (4,))
     limits = np.array([nu, nv, nw]) - 1.0
@@ -598,6 +623,107 @@ def shear_naive(volume, view, filt, transfer, step, passes):
         alpha = alpha * inside
         segment = np.concatenate([colour * alpha[..., None], alpha[..., None]], -1)
         image = image + (1.0 - image[..., 3:4]) * segment
+    return np.clip(image, 0.0, 1.0)
+
+
+def _shear2_exact_naive(view, transfer, plan, channels, volumes, ds):
+    """:func:`shear_naive`'s two passes with exact segment ends, pixel by pixel: slice ``w``
+    stands for ``[w - 1/2, w + 1/2]`` cut to the slab and to the ray's stretch inside; a cut
+    segment takes its own slice's sample where that lies in the stretch, else the next
+    slice's inward, with the cut part's length."""
+    u, v, w = plan.order
+    nw, nv, nu = np.transpose(channels[0], (2 - w, 2 - v, 2 - u)).shape
+    limits = np.array([nu, nv]) - 1.0
+    m = plan.matrix
+    inverse = np.linalg.inv(m[:2, :2])
+    order = range(nw) if plan.i > 0 else range(nw - 1, -1, -1)
+    length = abs(plan.i) * ds
+    image = np.zeros(view.shape + (4,))
+    for y in range(view.height):
+        for x in range(view.width):
+            start = inverse @ np.array([x - plan.shift[0], y - plan.shift[1]])
+            slope = inverse @ -np.array([m[0, 2], m[1, 2]])
+            w_lo, w_hi = 0.0, nw - 1.0
+            for a in range(2):  # where 0 <= start + w slope <= limits
+                if slope[a] == 0.0:
+                    if not 0.0 <= start[a] <= limits[a]:
+                        w_lo, w_hi = 1.0, 0.0
+                    continue
+                ends = sorted(((0.0 - start[a]) / slope[a], (limits[a] - start[a]) / slope[a]))
+                w_lo, w_hi = max(w_lo, ends[0]), min(w_hi, ends[1])
+            w_lo = 0.0 if w_lo <= 1e-9 else w_lo  # within rounding of an end slice: on it
+            w_hi = nw - 1.0 if w_hi >= nw - 1 - 1e-9 else w_hi
+            pixel = np.zeros(4)
+            for k in order:
+                lo, hi = max(k - 0.5, 0.0), min(k + 0.5, nw - 1.0)
+                cut_lo, cut_hi = max(lo, w_lo), min(hi, w_hi)
+                if not cut_hi > cut_lo:
+                    continue
+                share = (cut_hi - cut_lo)  # of a segment (the end slices' halves: 0.5)
+                take = k
+                if (cut_lo, cut_hi) != (lo, hi) and not w_lo <= k <= w_hi:
+                    take = k + 1 if k < w_lo else k - 1  # the next slice inward
+                    if not w_lo <= take <= w_hi:
+                        continue
+                values = [vol[take, y, x] for vol in volumes]
+                density = transfer.opacity_density(np.array([values[0]]))[0]
+                colour = transfer.emission(np.array([values[0]]))[0]
+                if len(values) > 1:
+                    grad = np.array(values[1:])
+                    if transfer.gradient_opacity is not None:
+                        density *= transfer.gradient_opacity.factor(np.linalg.norm(grad))
+                    if transfer.shading is not None:
+                        colour = (colour * transfer.shading.factor(grad, -view.forward)
+                                  + transfer.shading.highlight(grad, -view.forward))
+                alpha = -np.expm1(-density * length * share)
+                pixel = pixel + (1.0 - pixel[3]) * np.r_[colour * alpha, alpha]
+            image[y, x] = pixel
+    return np.clip(image, 0.0, 1.0)
+
+
+def _shear3_exact_naive(view, transfer, filt, plan, channels, lines, volumes, ds):
+    """:func:`shear_naive`'s three passes with exact segment ends, pixel by pixel."""
+    u, v, w = plan.order
+    nw, nv, nu = np.transpose(channels[0], (2 - w, 2 - v, 2 - u)).shape
+    limits = np.array([nu, nv, nw]) - 1.0
+    inverse = np.linalg.inv(plan.matrix)
+    depth = volumes[0].shape[0]
+    image = np.zeros(view.shape + (4,))
+    for y in range(view.height):
+        for x in range(view.width):
+            start = inverse @ (np.array([x, y, 0.0]) - plan.shift)
+            z_in, z_out = -np.inf, np.inf
+            for a in range(3):  # where 0 <= start + z inverse[:, 2] <= limits
+                slope = inverse[a, 2]
+                if slope == 0.0:
+                    if not 0.0 <= start[a] <= limits[a]:
+                        z_in, z_out = 1.0, 0.0
+                    continue
+                ends = sorted(((0.0 - start[a]) / slope, (limits[a] - start[a]) / slope))
+                z_in, z_out = max(z_in, ends[0]), min(z_out, ends[1])
+            pixel = np.zeros(4)
+            for z in range(depth):
+                lo, hi = max(z - 0.5, z_in), min(z + 0.5, z_out)
+                if not hi > lo:
+                    continue
+                if (lo, hi) == (z - 0.5, z + 0.5):  # whole: the lattice sample
+                    values = [vol[z, y, x] for vol in volumes]
+                else:  # cut by a face: its part's middle, pass 3 resampled there
+                    position = (0.5 * (lo + hi) - plan.t2 - plan.g * x - plan.h * y) / plan.i
+                    values = [line_at_naive(data[y, x], ok[y, x], position, filt)
+                              for data, ok in lines]
+                density = transfer.opacity_density(np.array([values[0]]))[0]
+                colour = transfer.emission(np.array([values[0]]))[0]
+                if len(values) > 1:
+                    grad = np.array(values[1:])
+                    if transfer.gradient_opacity is not None:
+                        density *= transfer.gradient_opacity.factor(np.linalg.norm(grad))
+                    if transfer.shading is not None:
+                        colour = (colour * transfer.shading.factor(grad, -view.forward)
+                                  + transfer.shading.highlight(grad, -view.forward))
+                alpha = -np.expm1(-density * ds * (hi - lo))
+                pixel = pixel + (1.0 - pixel[3]) * np.r_[colour * alpha, alpha]
+            image[y, x] = pixel
     return np.clip(image, 0.0, 1.0)
 
 

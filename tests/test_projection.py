@@ -11,9 +11,11 @@ from vrlib._scheduling import thread_count
 FIELD = data_gen.make_field("marschner-lobb")
 
 
-def projected(volume, view, filt, blend, step=0.5):
+def projected(volume, view, filt, blend, step=0.5, segment_ends="lattice"):
     """The projection computed from the public pieces: each ray's samples at (k + 1/2) ds
-    inside the volume's box, reconstructed by vrlib.reconstruct, then max or mean."""
+    inside the volume's box, reconstructed by vrlib.reconstruct, then max or mean. With exact
+    ends each segment [k ds, (k + 1) ds) is cut to the box, sampled at its part's middle and
+    weighed in the mean by that part's length."""
     origins, directions = view.rays()
     ds = step * float(volume.spacing.min())
     lo, hi = volume.extent[:, 0], volume.extent[:, 1]
@@ -26,12 +28,20 @@ def projected(volume, view, filt, blend, step=0.5):
                 ta, tb = (lo - o) / d, (hi - o) / d
             t_in = max(np.nanmax(np.minimum(ta, tb)), 0.0)
             t_out = np.nanmin(np.maximum(ta, tb))
-            k = np.arange(np.ceil(t_in / ds - 0.5), np.ceil(t_out / ds - 0.5))
-            t = (k + 0.5) * ds
-            t = t[(t >= t_in) & (t < t_out)]
+            if segment_ends == "exact":
+                k = np.arange(np.floor(t_in / ds), np.ceil(t_out / ds))
+                a, b = np.maximum(k * ds, t_in), np.minimum((k + 1) * ds, t_out)
+                keep = b > a
+                t, weights = 0.5 * (a + b)[keep], (b - a)[keep]
+            else:
+                k = np.arange(np.ceil(t_in / ds - 0.5), np.ceil(t_out / ds - 0.5))
+                t = (k + 0.5) * ds
+                t = t[(t >= t_in) & (t < t_out)]
+                weights = np.ones(t.size)
             if t.size:
                 values = vrlib.reconstruct(volume, o + t[:, None] * d, filter=filt)
-                out[r, c] = values.max() if blend == "maximum" else values.mean()
+                out[r, c] = (values.max() if blend == "maximum"
+                             else np.sum(weights * values) / np.sum(weights))
                 hit[r, c] = True
     return out, hit
 
@@ -51,6 +61,42 @@ def test_projection_equals_its_definition(blend, projection):
     np.testing.assert_allclose(img.rgba[..., :3], tf.emission(value) * alpha[..., None],
                                atol=1e-12)
     assert hit.sum() > 30 and img.stats.samples > 0
+
+
+@pytest.mark.parametrize("blend", ["maximum", "average"])
+@pytest.mark.parametrize("projection", ["orthographic", "perspective"])
+def test_projection_with_exact_ends_equals_its_definition(blend, projection):
+    """``segment_ends="exact"``: the segments the volume's faces cut are sampled at the middle
+    of their part inside, and the mean weighs each sample by its segment's part inside."""
+    vol = FIELD.sample(12)
+    view = vrlib.View.orbit(azimuth=25, elevation=15, size=10, projection=projection)
+    tf = vrlib.colormap("viridis", [(0, 0.1), (1, 0.9)], clim=(0, 1), volume=vol)
+    img = vrlib.render(vol, view, filter="catmull-rom", transfer=tf, blend=blend,
+                       segment_ends="exact")
+    value, hit = projected(vol, view, "catmull-rom", blend, segment_ends="exact")
+    alpha = np.where(hit, -np.expm1(-tf.opacity_density(value) * tf.unit_distance), 0.0)
+    np.testing.assert_allclose(img.alpha, alpha, atol=1e-12)
+    lattice = vrlib.render(vol, view, filter="catmull-rom", transfer=tf, blend=blend)
+    assert np.abs(img.alpha - lattice.alpha).max() > 1e-4  # the ends moved
+
+
+def test_average_with_exact_ends_converges_at_second_order():
+    """On Marschner-Lobb (live at the faces), steps 1 to 1/16: with exact ends the average's
+    change as the step halves falls 36 times over three halvings (second order: 64; first:
+    8), and its last change is 19 times smaller than with lattice ends, whose rays near the
+    silhouette also flip between taking a sample and none (changes of 7e-2 at some steps).
+    Measured on two views at 12^3 and 17^3: 36 to 73 times, and 19 to 2300 times smaller."""
+    vol = FIELD.sample(12)
+    view = vrlib.View.orbit(azimuth=25, elevation=15, size=16)
+    tf = vrlib.colormap("gray", [(0, 1), (1, 1)], clim=(0, 1))
+    changes = {}
+    for ends in ("lattice", "exact"):
+        images = [vrlib.render(vol, view, transfer=tf, blend="average", step=step,
+                               segment_ends=ends) for step in (1.0, 0.5, 0.25, 0.125, 0.0625)]
+        changes[ends] = [vrlib.metrics.rmse(a, b)
+                         for a, b in zip(images, images[1:], strict=False)]
+    assert changes["exact"][0] / changes["exact"][-1] > 20.0, changes
+    assert changes["exact"][-1] * 5.0 < changes["lattice"][-1], changes
 
 
 @pytest.mark.parametrize("filt", sorted(set(vrlib.FILTERS) - {"gaussian", "mitchell-netravali"}))
@@ -136,3 +182,9 @@ def test_projections_refuse_what_they_cannot_do():
         vrlib.render(vol, view, blend="average", transfer=vrlib.Glow(1, shading=vrlib.Phong()))
     with pytest.raises(ValueError, match="unknown blend 'mip'"):
         vrlib.render(vol, view, blend="mip")
+    with pytest.raises(TypeError, match="takes no method options but segment_ends"):
+        vrlib.render(vol, view, blend="average", step_budget=0.1)
+    with pytest.raises(TypeError, match="takes no method options with method='shearwarp'"):
+        vrlib.render(vol, view, blend="average", method="shearwarp", segment_ends="exact")
+    with pytest.raises(ValueError, match="segment_ends"):
+        vrlib.render(vol, view, blend="average", segment_ends="middle")

@@ -187,14 +187,17 @@ def render(volume, view, *, method="raycast", filter=None, transfer=None, step=N
                 f"give: use method='raycast' or method='shearwarp' (not {method!r}); "
                 + _WHY_NOT_PROJECTED.get(method, ""))
         refuse_gradients(transfer, f"blend={blend!r}", instead="blend='emission-absorption'")
-        if options:
-            raise TypeError(f"blend={blend!r} takes no method options, got {sorted(options)}")
+        takes = {"segment_ends"} if method == "raycast" else set()
+        if set(options) - takes:
+            raise TypeError(f"blend={blend!r} takes no method options"
+                            f"{' but segment_ends' if takes else ''} with method={method!r}, "
+                            f"got {sorted(options)}")
         with thread_count(threads):
             if method == "shearwarp":
                 return project_shearwarp(volume, view, filt=filt, transfer=transfer,
                                          blend=blend)
             return render_projection(volume, view, filt=filt, transfer=transfer, step=step,
-                                     blend=blend)
+                                     blend=blend, **options)
     if choose_filter:
         with thread_count(threads):
             return render_auto(volume, view, transfer=unwrapped, tolerance=tolerance,

@@ -38,7 +38,11 @@ from vrlib.image import Image, RenderStats
 from vrlib.prefilter import Tally, filter_lines, prepared, prepared_gradients
 from vrlib.value_bounds import reconstructed_range
 
-__all__ = ["render_shear3", "render_shear2", "ShearPlan", "plan_shear", "INTERMEDIATES"]
+__all__ = ["render_shear3", "render_shear2", "ShearPlan", "plan_shear", "INTERMEDIATES",
+           "SEGMENT_ENDS"]
+
+#: How the shear methods count the segments that the volume's faces cut (``segment_ends``).
+SEGMENT_ENDS = ("lattice", "exact")
 
 
 class ShearPlan:
@@ -272,11 +276,15 @@ def _intermediate(intermediate, volume):
 
 
 def render_shear3(volume, view, *, filt, transfer, step, early_termination,
-                  empty_space_skipping, intermediate="auto"):
+                  empty_space_skipping, intermediate="auto", segment_ends="lattice"):
     """Three-pass shear rendering (arguments validated by :func:`vrlib.render`).
     ``intermediate`` stores the resampled volumes as float32 (half the memory) or float64;
     ``"auto"`` takes float32 unless the volume's magnitudes need float64 (chapter ch08
-    measures the difference: about 1e-8 in the image)."""
+    measures the difference: about 1e-8 in the image). ``segment_ends`` as the ray
+    caster's: ``"lattice"`` lets each sample inside the volume stand for its whole segment
+    of the ray, ``"exact"`` counts only the part inside of the segments that the volume's
+    faces cut, each sampled at its middle (pass 3 resamples the ray there)."""
+    exact = validate.choice("segment_ends", segment_ends, SEGMENT_ENDS) == "exact"
     _check(view)
     dtype = _intermediate(intermediate, volume)
     start = time.perf_counter()
@@ -294,7 +302,7 @@ def render_shear3(volume, view, *, filt, transfer, step, early_termination,
         filt.radius, filt.taps, plan.depth_samples,
         np.linalg.inv(plan.matrix), plan.shift, limits, *tables,
         grads.transpose(0, 2, 3, 1), *kernel_lighting(transfer, view.forward), early_termination,
-        out, resampled, counts)
+        out, resampled, counts, exact)
     count["pass3"] = int(resampled.sum())
     largest = max(count["buffers"], v2.nbytes)
     del v2
@@ -304,10 +312,14 @@ def render_shear3(volume, view, *, filt, transfer, step, early_termination,
 
 
 def render_shear2(volume, view, *, filt, transfer, step, early_termination,
-                  empty_space_skipping, intermediate="auto"):
+                  empty_space_skipping, intermediate="auto", segment_ends="lattice"):
     """Two-pass shear rendering (arguments validated by :func:`vrlib.render`). ``step`` sets
     the lattice of the image plane only: samples along a ray are the volume's slices.
-    ``intermediate`` as for :func:`render_shear3`."""
+    ``intermediate`` as for :func:`render_shear3`. ``segment_ends="exact"`` counts only the
+    part inside of the segments that the volume's side faces cut, each by the nearest slice
+    sample inside on the pixel's ray (the end slices keep their half segments):
+    :func:`vrlib._kernels.shear.composite_slices`."""
+    exact = validate.choice("segment_ends", segment_ends, SEGMENT_ENDS) == "exact"
     _check(view)
     dtype = _intermediate(intermediate, volume)
     start = time.perf_counter()
@@ -324,7 +336,7 @@ def render_shear2(volume, view, *, filt, transfer, step, early_termination,
     counts = np.zeros(view.height, np.int64)
     _kernel.composite_slices(v2, plan.i > 0, inverse2, shift, limits, *tables, grads,
                              *kernel_lighting(transfer, view.forward), early_termination, out,
-                             counts)
+                             counts, exact)
     stats = _stats(volume, filt.taps, count, int(counts.sum()), time.perf_counter() - start,
                    count["buffers"])
     return Image(np.clip(out, 0.0, 1.0), tally.finish(stats, filt))

@@ -18,12 +18,15 @@ MAXIMUM, AVERAGE = 0, 1
 
 @parallel_jit
 def project(data, gshape, origin, spacing, box_lo, box_hi, camera, height, width, ds, fkind,
-            fp0, fp1, fp2, radius, ntaps, blend, value, hit, samples):
+            fp0, fp1, fp2, radius, ntaps, blend, value, hit, samples, exact):
     """``value[row, col]``: the largest (``blend = MAXIMUM``) or mean (``AVERAGE``) value
     reconstructed at the samples ``t = (k + 1/2) ds`` of the pixel's ray inside the box, the
     same positions the ray caster samples; ``hit`` says whether the ray took any sample,
-    ``samples[row]`` counts them. Rows run in parallel, each pixel on its own: the image does
-    not depend on the thread count."""
+    ``samples[row]`` counts them. With ``exact`` segment ends, as the ray caster's: sample
+    ``k`` stands for ``[k ds, (k + 1) ds)``, and where the box's faces cut that segment the
+    sample lies at the middle of its part inside and the mean weighs it by that part's
+    length. Rows run in parallel, each pixel on its own: the image does not depend on the
+    thread count."""
     inv0, inv1, inv2 = 1.0 / spacing[0], 1.0 / spacing[1], 1.0 / spacing[2]
     offset = np.zeros(3, dtype=np.int64)
     # Borrowed views (no reference counts) for the call per sample: counting references to
@@ -41,11 +44,21 @@ def project(data, gshape, origin, spacing, box_lo, box_hi, camera, height, width
             t_in = max(t_in, 0.0)
             best = -math.inf
             total = 0.0
+            weights = 0.0
             count = 0
-            k = math.ceil(t_in / ds - 0.5)
+            k = math.floor(t_in / ds) if exact else math.ceil(t_in / ds - 0.5)
             while t_out > t_in:
                 t = (k + 0.5) * ds
-                if t >= t_out:
+                part = 1.0
+                if exact and (k * ds < t_in or (k + 1) * ds > t_out):  # a cut segment
+                    a, b = max(k * ds, t_in), min((k + 1) * ds, t_out)
+                    if not b > a:
+                        if a >= t_out:
+                            break
+                        k += 1
+                        continue
+                    t, part = 0.5 * (a + b), (b - a) / ds
+                elif t >= t_out:
                     break
                 ux = (o[0] + t * d[0] - origin[0]) * inv0
                 uy = (o[1] + t * d[1] - origin[1]) * inv1
@@ -57,7 +70,8 @@ def project(data, gshape, origin, spacing, box_lo, box_hi, camera, height, width
                                     fp1, fp2, radius, ntaps, borrowed(wx), borrowed(wy),
                                     borrowed(wz))
                 best = max(best, v)
-                total += v
+                total += v * part if exact else v
+                weights += part
                 count += 1
                 k += 1
             hit[r, c] = count > 0
@@ -66,6 +80,6 @@ def project(data, gshape, origin, spacing, box_lo, box_hi, camera, height, width
             elif blend == MAXIMUM:
                 value[r, c] = best
             else:
-                value[r, c] = total / count
+                value[r, c] = total / weights if exact else total / count
             taken += count
         samples[r] = taken

@@ -234,7 +234,7 @@ def _over_lit(value, fraction, gx, gy, gz, tstart, tinv, alpha_tab, emit_tab, li
 def resample_composite(src, c0, c1, c2, offset, line_lo, line_hi, fkind, fp0, fp1, fp2, radius,
                        ntaps, n_z, inverse, shift, limits, tstart, tinv, alpha_tab, color_tab,
                        emit_tab, grads, lit, ramp_x, ramp_y, threshold, out, resampled,
-                       composited):
+                       composited, exact):
     """Three-pass shearing's last pass fused with its compositing: the pass-3 line of pixel
     ``(x, y)`` is that pixel's ray. ``src[y, x, w]`` is pass 2's output seen along the lines of
     pass 3 (``line_lo .. line_hi`` filled, as for :func:`shear_pass`); lattice sample ``z`` of
@@ -245,7 +245,11 @@ def resample_composite(src, c0, c1, c2, offset, line_lo, line_hi, fkind, fp0, fp
     ``src``); opaque pixels take no more samples. ``resampled[y]`` and ``composited[y]`` count
     the work. With ``grads`` (``[3, y, x, w]``: the gradient's components after pass 2;
     ``no_gradients()`` for none) each sample's gradient is resampled with the same weights and
-    the sample is classified by it too (:func:`_over_lit`)."""
+    the sample is classified by it too (:func:`_over_lit`). With ``exact`` segment ends,
+    sample ``z`` stands for ``[z - 1/2, z + 1/2]``: only the samples whose whole segment lies
+    in the volume are composited so, and the parts inside of the segments that its faces cut
+    (before the first and after the last of those) are each sampled at their middle, with
+    their length, and composited in front of and behind them after."""
     height, width = out.shape[0], out.shape[1]
     n = src.shape[2]
     lighting = lit[0] != 0.0 or lit[2] != 0.0  # shading or gradient opacity
@@ -258,10 +262,26 @@ def resample_composite(src, c0, c1, c2, offset, line_lo, line_hi, fkind, fp0, fp
         z_last = np.empty(width, np.int64)
         q_first = np.empty(width, np.int64)
         q_last = np.empty(width, np.int64)
+        # Exact ends: each ray's stretch inside the volume, and its first and last sample
+        # whose whole segment lies in it.
+        stretch = np.empty((width, 2))
+        whole = np.empty((width, 2), np.int64)
+        part = np.zeros((1, 1, 4))
         row_lo = n_z
         row_hi = -1
         for x in range(width):
             z_first[x], z_last[x] = _inside_range(inverse, shift, limits, x, y, n_z)
+            if exact:
+                z_in, z_out = -math.inf, math.inf
+                for a in range(3):
+                    u0 = inverse[a, 0] * (x - shift[0]) + inverse[a, 1] * (y - shift[1]) \
+                        - inverse[a, 2] * shift[2]
+                    z_in, z_out = _within(u0, inverse[a, 2], limits[a], z_in, z_out)
+                stretch[x, 0], stretch[x, 1] = z_in, z_out
+                whole[x, 0], whole[x, 1] = 1, 0
+                if z_in <= z_out:
+                    whole[x, 0] = int(math.ceil(z_in + 0.5))
+                    whole[x, 1] = int(math.floor(z_out - 0.5))
             q_first[x] = 0
             q_last[x] = -1
             lo = max(0, line_lo[y, x])
@@ -281,6 +301,8 @@ def resample_composite(src, c0, c1, c2, offset, line_lo, line_hi, fkind, fp0, fp
             for x in range(width):
                 if not z_first[x] <= z <= z_last[x] or out[y, x, 3] >= threshold:
                     continue
+                if exact and not whole[x, 0] <= z <= whole[x, 1]:
+                    continue  # a segment the volume's faces cut: below
                 inside = True
                 for a in range(3):
                     u = (inverse[a, 0] * (x - shift[0]) + inverse[a, 1] * (y - shift[1])
@@ -307,13 +329,47 @@ def resample_composite(src, c0, c1, c2, offset, line_lo, line_hi, fkind, fp0, fp
                               ramp_x, ramp_y, out, y, x, lit[10], lit[11], lit[12])
                 else:
                     _over(value, 1.0, tstart, tinv, alpha_tab, color_tab, out, y, x)
+        for x in range(width):
+            if not exact or stretch[x, 0] > stretch[x, 1]:
+                continue
+            z_in, z_out = stretch[x, 0], stretch[x, 1]
+            low_end, high_start = whole[x, 0] - 0.5, whole[x, 1] + 0.5
+            if whole[x, 0] > whole[x, 1]:  # within two segments: where they meet
+                low_end = high_start = min(math.floor(z_in + 0.5) + 0.5, z_out)
+            lo = max(0, line_lo[y, x])
+            hi = min(n - 1, line_hi[y, x])
+            base = offset + c1 * x + c2 * y
+            for side in range(2):  # 0: in front (lower z), 1: behind
+                a, b = (z_in, low_end) if side == 0 else (high_start, z_out)
+                if not b > a:
+                    continue
+                position = (0.5 * (a + b) - base) / c0
+                value = gx = gy = gz = 0.0
+                if lo <= hi and lo - radius <= position <= hi + radius:
+                    first = _line_taps(fkind, fp0, fp1, fp2, radius, ntaps, position,
+                                       borrowed(w))
+                    value = _taps_sum(src, y, x, lo, hi, first, ntaps, w)
+                    if lighting:
+                        gx = _taps_sum(grads[0], y, x, lo, hi, first, ntaps, w)
+                        gy = _taps_sum(grads[1], y, x, lo, hi, first, ntaps, w)
+                        gz = _taps_sum(grads[2], y, x, lo, hi, first, ntaps, w)
+                    taken += 1
+                done += 1
+                part[0, 0, 0] = part[0, 0, 1] = part[0, 0, 2] = part[0, 0, 3] = 0.0
+                if lighting:
+                    _over_lit(value, b - a, gx, gy, gz, tstart, tinv, alpha_tab, emit_tab,
+                              lit, ramp_x, ramp_y, part, 0, 0, lit[10], lit[11], lit[12])
+                else:
+                    _over(value, b - a, tstart, tinv, alpha_tab, color_tab, part, 0, 0)
+                _in_front_or_behind(out, y, x, part, side == 0)
         resampled[y] = taken
         composited[y] = done
 
 
 @parallel_jit
 def composite_slices(vol, front_to_back, inverse2, shift, limits, tstart, tinv, alpha_tab,
-                     color_tab, emit_tab, grads, lit, ramp_x, ramp_y, threshold, out, counts):
+                     color_tab, emit_tab, grads, lit, ramp_x, ramp_y, threshold, out, counts,
+                     exact):
     """Two-pass compositing: ``vol[w, Y, X]`` holds slice ``w`` resampled onto the image's
     rows and columns; each pixel composites the slices in view order, each a segment of the
     same length (the table's) but the first and last, which reach half as far into the volume.
@@ -322,7 +378,14 @@ def composite_slices(vol, front_to_back, inverse2, shift, limits, tstart, tinv, 
     pixels of a row advance together, slice by slice (contiguous reads); each pixel visits only
     the slices its ray can meet inside the volume. With ``grads`` (``[3, w, Y, X]``, the
     gradient's components resampled like ``vol``; ``no_gradients()`` for none) samples are
-    classified by their gradient too (:func:`_over_lit`)."""
+    classified by their gradient too (:func:`_over_lit`). With ``exact`` segment ends, slice
+    ``w`` stands for ``[w - 1/2, w + 1/2]`` (cut to ``[0, n_w - 1]``): only the slices whose
+    whole segment lies in the volume on the pixel's ray are composited so, and the part
+    inside of each segment that a side face cuts (before the first and after the last of
+    those) after, in front of or behind them, with its length, by the sample of its own slice
+    where that lies inside, else of the next slice inward (a segment away at most: the
+    pixel's ray meets the slices only at their samples). A ray that meets no slice inside the
+    volume takes nothing either way."""
     n_w, height, width = vol.shape
     lighting = lit[0] != 0.0 or lit[2] != 0.0  # shading or gradient opacity
     alpha_tab, emit_tab, lit, ramp_x, ramp_y, out = _lit_views(alpha_tab, emit_tab, lit,
@@ -331,6 +394,9 @@ def composite_slices(vol, front_to_back, inverse2, shift, limits, tstart, tinv, 
         y = np.int64(row_index)
         w_first = np.empty(width, np.int64)
         w_last = np.empty(width, np.int64)
+        stretch = np.empty((width, 2))
+        whole = np.empty((width, 2), np.int64)
+        part = np.zeros((1, 1, 4))
         for x in range(width):
             # (u, v) are linear in w: the slices inside, widened by one (the test is exact).
             w_lo = 0.0
@@ -339,6 +405,8 @@ def composite_slices(vol, front_to_back, inverse2, shift, limits, tstart, tinv, 
                 u0 = (inverse2[a, 0] * (x - shift[0]) + inverse2[a, 1] * (y - shift[1]))
                 slope = -(inverse2[a, 0] * shift[2] + inverse2[a, 1] * shift[3])
                 w_lo, w_hi = _within(u0, slope, limits[a], w_lo, w_hi)
+            stretch[x, 0], stretch[x, 1] = w_lo, w_hi
+            whole[x, 0], whole[x, 1] = _whole_segments(w_lo, w_hi, n_w)
             if w_lo > w_hi:
                 w_first[x], w_last[x] = 0, -1
             else:
@@ -351,6 +419,8 @@ def composite_slices(vol, front_to_back, inverse2, shift, limits, tstart, tinv, 
             for x in range(width):
                 if not w_first[x] <= w <= w_last[x] or out[y, x, 3] >= threshold:
                     continue
+                if exact and not whole[x, 0] <= w <= whole[x, 1]:
+                    continue  # a segment a side face cuts: below
                 dx = x - shift[0] - w * shift[2]
                 dy = y - shift[1] - w * shift[3]
                 u = inverse2[0, 0] * dx + inverse2[0, 1] * dy
@@ -364,7 +434,63 @@ def composite_slices(vol, front_to_back, inverse2, shift, limits, tstart, tinv, 
                               ramp_x, ramp_y, out, y, x, lit[10], lit[11], lit[12])
                 else:
                     _over(vol[w, y, x], end, tstart, tinv, alpha_tab, color_tab, out, y, x)
+        for x in range(width):
+            w_lo, w_hi = stretch[x, 0], stretch[x, 1]
+            if not exact or w_lo > w_hi:
+                continue
+            low_end, high_start = _cut_bounds(w_lo, w_hi, whole[x, 0], whole[x, 1], n_w)
+            for side in range(2):  # 0: the low end (slice 0's side), 1: the high end
+                a, b = (w_lo, low_end) if side == 0 else (high_start, w_hi)
+                if not b > a:
+                    continue
+                w = int(math.floor(0.5 * (a + b) + 0.5))  # the segment's own slice
+                if w < w_lo:
+                    w += 1
+                elif w > w_hi:
+                    w -= 1
+                if not w_lo <= w <= w_hi:
+                    continue  # no slice inside the volume on this ray
+                done += 1
+                part[0, 0, 0] = part[0, 0, 1] = part[0, 0, 2] = part[0, 0, 3] = 0.0
+                if lighting:
+                    _over_lit(vol[w, y, x], b - a, grads[0, w, y, x], grads[1, w, y, x],
+                              grads[2, w, y, x], tstart, tinv, alpha_tab, emit_tab, lit,
+                              ramp_x, ramp_y, part, 0, 0, lit[10], lit[11], lit[12])
+                else:
+                    _over(vol[w, y, x], b - a, tstart, tinv, alpha_tab, color_tab, part, 0, 0)
+                _in_front_or_behind(out, y, x, part, (side == 0) == front_to_back)
         counts[y] = done
+
+
+#: Slice coordinates within this of an end slice count as on it (:func:`_whole_segments`):
+#: rays through the edge of an end slice meet the side faces there, at 0 or a rounding from
+#: it. The same as :data:`vrlib.shearwarp.SLAB_EDGE`.
+SLAB_EDGE = 1e-9
+
+
+@jit(inline="always")
+def _whole_segments(k_lo, k_hi, n_k):
+    """The first and last slice whose segment (``[k - 1/2, k + 1/2]`` cut to ``[0, n_k -
+    1]``) lies wholly in the stretch ``[k_lo, k_hi]`` of slice coordinates; first > last where
+    none does (:func:`vrlib.shearwarp.whole_planes` with one plane per slice)."""
+    if k_lo > k_hi:
+        return 1, 0
+    first = 0 if k_lo <= SLAB_EDGE else int(math.ceil(k_lo + 0.5))
+    last = n_k - 1 if k_hi >= n_k - 1.0 - SLAB_EDGE else int(math.floor(k_hi - 0.5))
+    return first, last
+
+
+@jit(inline="always")
+def _cut_bounds(k_lo, k_hi, first, last, n_k):
+    """Where the stretch ``[k_lo, k_hi]``'s cut parts end and start: ``(low_end,
+    high_start)``, the parts being ``[k_lo, low_end]`` and ``[high_start, k_hi]`` (empty
+    beside an end slice whose half segment is whole); with no whole segment (``first >
+    last``) the stretch meets two segments at most, and both bounds are where they meet."""
+    if first > last:
+        meet = min(math.floor(k_lo + 0.5) + 0.5, n_k - 1.0, k_hi)
+        return meet, meet
+    return (k_lo if first == 0 else max(first - 0.5, k_lo),
+            k_hi if last == n_k - 1 else min(last + 0.5, k_hi))
 
 
 @helper_jit
@@ -386,6 +512,21 @@ def _slice_sum(slices, k, rows, i0, ntaps, wi, wj):
                 line += wi[a] * slices[k, rows[b], clamp(i0 + a, n_i)]
             value += wj[b] * line
     return value
+
+
+@jit(inline="always")
+def _in_front_or_behind(buf, y, x, part, in_front):
+    """Composite ``part[0, 0]`` (premultiplied RGBA, alone) in front of ``buf[y, x]`` or behind
+    it: the over operator is associative, so a segment composited so after the others gives
+    the image composited in order."""
+    if in_front:
+        behind = 1.0 - part[0, 0, 3]
+        for ch in range(4):
+            buf[y, x, ch] = part[0, 0, ch] + behind * buf[y, x, ch]
+    else:
+        front = 1.0 - buf[y, x, 3]
+        for ch in range(4):
+            buf[y, x, ch] += front * part[0, 0, ch]
 
 
 @jit(inline="always")
@@ -595,16 +736,7 @@ def shear_cut_ends(slices, planes, ascending, ends, fraction, fkind, fp0, fp1, f
                               rays[ray_j, ray_i, 2])
                 else:
                     _over(value, length, tstart, tinv, alpha_tab, color_tab, part, 0, 0)
-                if (side == 0) == ascending:
-                    # In front: the part over what lies behind it.
-                    behind = 1.0 - part[0, 0, 3]
-                    for ch in range(4):
-                        inter[big_j, big_i, ch] = part[0, 0, ch] + behind * inter[big_j, big_i,
-                                                                                   ch]
-                else:  # behind: under what lies in front of it
-                    front = 1.0 - inter[big_j, big_i, 3]
-                    for ch in range(4):
-                        inter[big_j, big_i, ch] += front * part[0, 0, ch]
+                _in_front_or_behind(inter, big_j, big_i, part, (side == 0) == ascending)
         counts[big_j] += done
 
 
