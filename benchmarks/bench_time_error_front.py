@@ -7,8 +7,9 @@ error and a time. vrlib's answer is the fastest of its fixed settings whose erro
 the peer's: ray casting (trilinear, steps 32 to 1/4 voxel, by factors of sqrt 2 below 4,
 lattice or exact segment ends) and every other method at its defaults (:data:`OTHERS`:
 shear-warp, trilinear and Catmull-Rom, and trilinear with 2, 3 and 4 sample planes per slice
-spacing; the two- and three-pass shears and splatting, trilinear), and the time of ``render(..., tolerance=error)``, the promise a user would ask
-for. The ratio is vrlib's time over the peer's (the issue's target: at most 0.2).
+spacing; the two- and three-pass shears and splatting, trilinear), and the time of
+``render(..., tolerance=error)``, the promise a user would ask for. The ratio is vrlib's
+time over the peer's (the issue's target: at most 0.2).
 
 Errors are the rmse of premultiplied RGB (VTK gives no alpha) against the exact image of
 the trilinear field, approximated by vrlib at a step of 1/16 voxel with exact segment ends

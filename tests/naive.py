@@ -626,6 +626,23 @@ def shear_naive(volume, view, filt, transfer, step, passes, segment_ends="lattic
     return np.clip(image, 0.0, 1.0)
 
 
+def _over_naive(pixel, values, transfer, view, length):
+    """``pixel`` (premultiplied RGBA) with a segment of ``length`` (world units) composited
+    behind it, classified from ``values`` (the value, then the gradient's components if the
+    transfer function needs them) as seen along the view's direction."""
+    density = transfer.opacity_density(np.array([values[0]]))[0]
+    colour = transfer.emission(np.array([values[0]]))[0]
+    if len(values) > 1:
+        grad = np.array(values[1:])
+        if transfer.gradient_opacity is not None:
+            density *= transfer.gradient_opacity.factor(np.linalg.norm(grad))
+        if transfer.shading is not None:
+            colour = (colour * transfer.shading.factor(grad, -view.forward)
+                      + transfer.shading.highlight(grad, -view.forward))
+    alpha = -np.expm1(-density * length)
+    return pixel + (1.0 - pixel[3]) * np.r_[colour * alpha, alpha]
+
+
 def _shear2_exact_naive(view, transfer, plan, channels, volumes, ds):
     """:func:`shear_naive`'s two passes with exact segment ends, pixel by pixel: slice ``w``
     stands for ``[w - 1/2, w + 1/2]`` cut to the slab and to the ray's stretch inside; a cut
@@ -665,18 +682,8 @@ def _shear2_exact_naive(view, transfer, plan, channels, volumes, ds):
                     take = k + 1 if k < w_lo else k - 1  # the next slice inward
                     if not w_lo <= take <= w_hi:
                         continue
-                values = [vol[take, y, x] for vol in volumes]
-                density = transfer.opacity_density(np.array([values[0]]))[0]
-                colour = transfer.emission(np.array([values[0]]))[0]
-                if len(values) > 1:
-                    grad = np.array(values[1:])
-                    if transfer.gradient_opacity is not None:
-                        density *= transfer.gradient_opacity.factor(np.linalg.norm(grad))
-                    if transfer.shading is not None:
-                        colour = (colour * transfer.shading.factor(grad, -view.forward)
-                                  + transfer.shading.highlight(grad, -view.forward))
-                alpha = -np.expm1(-density * length * share)
-                pixel = pixel + (1.0 - pixel[3]) * np.r_[colour * alpha, alpha]
+                pixel = _over_naive(pixel, [vol[take, y, x] for vol in volumes], transfer,
+                                    view, length * share)
             image[y, x] = pixel
     return np.clip(image, 0.0, 1.0)
 
@@ -712,17 +719,7 @@ def _shear3_exact_naive(view, transfer, filt, plan, channels, lines, volumes, ds
                     position = (0.5 * (lo + hi) - plan.t2 - plan.g * x - plan.h * y) / plan.i
                     values = [line_at_naive(data[y, x], ok[y, x], position, filt)
                               for data, ok in lines]
-                density = transfer.opacity_density(np.array([values[0]]))[0]
-                colour = transfer.emission(np.array([values[0]]))[0]
-                if len(values) > 1:
-                    grad = np.array(values[1:])
-                    if transfer.gradient_opacity is not None:
-                        density *= transfer.gradient_opacity.factor(np.linalg.norm(grad))
-                    if transfer.shading is not None:
-                        colour = (colour * transfer.shading.factor(grad, -view.forward)
-                                  + transfer.shading.highlight(grad, -view.forward))
-                alpha = -np.expm1(-density * ds * (hi - lo))
-                pixel = pixel + (1.0 - pixel[3]) * np.r_[colour * alpha, alpha]
+                pixel = _over_naive(pixel, values, transfer, view, ds * (hi - lo))
             image[y, x] = pixel
     return np.clip(image, 0.0, 1.0)
 

@@ -26,6 +26,7 @@ import numpy as np
 from vrlib import validate
 from vrlib._kernels import shear as _kernel
 from vrlib._kernels._jit import readonly
+from vrlib._kernels.shear import SLAB_EDGE
 from vrlib._scheduling import on_threads, thread_number
 from vrlib.gradients import kernel_lighting, no_gradients
 from vrlib.image import Image, RenderStats
@@ -45,10 +46,6 @@ WARP_BAND = 16
 MAX_PLANES_PER_SLICE = 64
 #: How shear-warp counts the segments that the volume's side faces cut (``segment_ends``).
 SEGMENT_ENDS = ("lattice", "exact")
-#: Slice coordinates within this of an end slice count as on it (:func:`whole_planes`): the
-#: intermediate image's pixels lie on the front slice's lattice, so rays through its edge
-#: meet the side faces there, at 0 or a rounding from it.
-SLAB_EDGE = 1e-9
 
 
 def ray_stretches(ends, shape, slice_shape):

@@ -438,7 +438,7 @@ def composite_slices(vol, front_to_back, inverse2, shift, limits, tstart, tinv, 
             w_lo, w_hi = stretch[x, 0], stretch[x, 1]
             if not exact or w_lo > w_hi:
                 continue
-            low_end, high_start = _cut_bounds(w_lo, w_hi, whole[x, 0], whole[x, 1], n_w)
+            low_end, high_start = _cut_bounds(w_lo, w_hi, whole[x, 0], whole[x, 1], n_w, 1)
             for side in range(2):  # 0: the low end (slice 0's side), 1: the high end
                 a, b = (w_lo, low_end) if side == 0 else (high_start, w_hi)
                 if not b > a:
@@ -462,9 +462,10 @@ def composite_slices(vol, front_to_back, inverse2, shift, limits, tstart, tinv, 
         counts[y] = done
 
 
-#: Slice coordinates within this of an end slice count as on it (:func:`_whole_segments`):
-#: rays through the edge of an end slice meet the side faces there, at 0 or a rounding from
-#: it. The same as :data:`vrlib.shearwarp.SLAB_EDGE`.
+#: Slice coordinates within this of an end slice count as on it (:func:`_whole_segments`,
+#: :func:`vrlib.shearwarp.whole_planes`): the intermediate image's and the two-pass slices'
+#: pixels lie on the front slice's lattice, so rays through its edge meet the side faces
+#: there, at 0 or a rounding from it.
 SLAB_EDGE = 1e-9
 
 
@@ -481,16 +482,19 @@ def _whole_segments(k_lo, k_hi, n_k):
 
 
 @jit(inline="always")
-def _cut_bounds(k_lo, k_hi, first, last, n_k):
-    """Where the stretch ``[k_lo, k_hi]``'s cut parts end and start: ``(low_end,
-    high_start)``, the parts being ``[k_lo, low_end]`` and ``[high_start, k_hi]`` (empty
-    beside an end slice whose half segment is whole); with no whole segment (``first >
-    last``) the stretch meets two segments at most, and both bounds are where they meet."""
+def _cut_bounds(k_lo, k_hi, first, last, n_k, planes):
+    """Where the stretch ``[k_lo, k_hi]`` of slice coordinates has its cut parts, on
+    ``planes`` planes per slice spacing from slice 0 whose segments ``first .. last`` (plane
+    numbers) lie wholly in it: ``(low_end, high_start)``, the parts being ``[k_lo,
+    low_end]`` and ``[high_start, k_hi]`` (empty beside an end slice whose half segment is
+    whole). With no whole segment (``first > last``) the stretch meets two segments at
+    most, and both bounds are where they meet."""
+    h = 1.0 / planes
     if first > last:
-        meet = min(math.floor(k_lo + 0.5) + 0.5, n_k - 1.0, k_hi)
+        meet = min(math.floor(k_lo * planes + 0.5) * h + 0.5 * h, n_k - 1.0, k_hi)
         return meet, meet
-    return (k_lo if first == 0 else max(first - 0.5, k_lo),
-            k_hi if last == n_k - 1 else min(last + 0.5, k_hi))
+    return (k_lo if first == 0 else max(first * h - 0.5 * h, k_lo),
+            k_hi if last == (n_k - 1) * planes else min(last * h + 0.5 * h, k_hi))
 
 
 @helper_jit
@@ -562,9 +566,10 @@ def shear_slices(slices, order, other, between, scale, di, dj, fraction, fkind, 
     ``inter.shape[:2]``; ``(1, 1)`` for none), pixel ``(I, J)`` takes plane ``p`` only where
     ``full_first[J, I] <= lattice[p] <= full_last[J, I]`` (``lattice[p]``: the plane's place
     on the planes' lattice, from slice 0): the planes whose whole segment lies inside the
-    volume; :func:`shear_cut_ends` adds the parts of the others. Each task owns intermediate rows: no races. With ``grads`` (``[3, k, j, i]``, the
-    gradient's components in slice order; ``no_gradients()`` for none) each sample's gradient is
-    resampled with the same weights and the sample classified by it too (:func:`_over_lit`),
+    volume; :func:`shear_cut_ends` adds the parts of the others. Each task owns intermediate
+    rows: no races. With ``grads`` (``[3, k, j, i]``, the gradient's components in slice
+    order; ``no_gradients()`` for none) each sample's gradient is resampled with the same
+    weights and the sample classified by it too (:func:`_over_lit`),
     seen along ``rays[J, I]`` (world unit directions, shape ``(1, 1, 3)``: the view's one
     direction).
     """
@@ -666,13 +671,13 @@ def shear_cut_ends(slices, planes, ascending, ends, fraction, fkind, fp0, fp1, f
     first and last slice and all three are linear in ``k``. The planes ``full_first ..
     full_last`` lie wholly inside; the part of the ray inside before the first of them (or
     the parts of the one or two segments it meets, where none is) and after the last are
-    each one segment's part, sampled at its middle (the two slices about it interpolated linearly, as a plane between them), of
-    length over ``h`` times ``fraction[J, I]`` (perspective) the table's."""
+    each one segment's part (:func:`_cut_bounds`), sampled at its middle (the two slices
+    about it interpolated linearly, as a plane between them), of length over ``h`` times
+    ``fraction[J, I]`` (perspective) the table's."""
     lighting = lit[0] != 0.0 or lit[2] != 0.0
     n_k, n_j, n_i = slices.shape
     height, width = inter.shape[0], inter.shape[1]
     h = 1.0 / planes
-    last = (n_k - 1) * planes
     alpha_tab, emit_tab, lit, ramp_x, ramp_y, inter = _lit_views(alpha_tab, emit_tab, lit,
                                                                  ramp_x, ramp_y, inter)
     slices, grads = borrowed(slices), borrowed(grads)
@@ -687,15 +692,8 @@ def shear_cut_ends(slices, planes, ascending, ends, fraction, fkind, fp0, fp1, f
             k_lo, k_hi = inside[big_j, big_i, 0], inside[big_j, big_i, 1]
             if k_lo > k_hi:
                 continue
-            q_a, q_b = full_first[big_j, big_i], full_last[big_j, big_i]
-            # Where the low part ends and the high one starts: none beside an end slice
-            # whose half segment is whole (whole_planes); with no plane wholly inside, the
-            # end of the segment that holds k_lo (the stretch meets two at most).
-            low_end = k_lo if q_a == 0 else max(q_a * h - 0.5 * h, k_lo)
-            high_start = k_hi if q_b == last else min(q_b * h + 0.5 * h, k_hi)
-            if q_a > q_b:
-                low_end = high_start = min(
-                    math.floor(k_lo * planes + 0.5) * h + 0.5 * h, n_k - 1.0, k_hi)
+            low_end, high_start = _cut_bounds(k_lo, k_hi, full_first[big_j, big_i],
+                                              full_last[big_j, big_i], n_k, planes)
             for side in range(2):  # 0: the low end (slice 0's side), 1: the high end
                 a, b = (k_lo, low_end) if side == 0 else (high_start, k_hi)
                 if not b > a:
