@@ -653,7 +653,7 @@ def shear_slices(slices, order, other, between, scale, di, dj, fraction, fkind, 
         counts[big_j] = done
 
 
-@parallel_jit
+@jit
 def shear_cut_ends(slices, planes, ascending, ends, fraction, fkind, fp0, fp1, fp2, radius,
                    ntaps, tstart, tinv, alpha_tab, color_tab, emit_tab, grads, lit, ramp_x,
                    ramp_y, rays, inside, full_first, full_last, inter, counts):
@@ -673,7 +673,8 @@ def shear_cut_ends(slices, planes, ascending, ends, fraction, fkind, fp0, fp1, f
     the parts of the one or two segments it meets, where none is) and after the last are
     each one segment's part (:func:`_cut_bounds`), sampled at its middle (the two slices
     about it interpolated linearly, as a plane between them), of length over ``h`` times
-    ``fraction[J, I]`` (perspective) the table's."""
+    ``fraction[J, I]`` (perspective) the table's. Serial: two samples a ray at most, where
+    numba's parallel passes would lengthen its compile by more than it runs."""
     lighting = lit[0] != 0.0 or lit[2] != 0.0
     n_k, n_j, n_i = slices.shape
     height, width = inter.shape[0], inter.shape[1]
@@ -681,12 +682,11 @@ def shear_cut_ends(slices, planes, ascending, ends, fraction, fkind, fp0, fp1, f
     alpha_tab, emit_tab, lit, ramp_x, ramp_y, inter = _lit_views(alpha_tab, emit_tab, lit,
                                                                  ramp_x, ramp_y, inter)
     slices, grads = borrowed(slices), borrowed(grads)
-    for row in prange(height):
-        big_j = np.int64(row)
-        wi = np.empty(8)
-        wj = np.empty(8)
-        rows = np.empty(8, np.int64)
-        part = np.zeros((1, 1, 4))
+    wi = np.empty(8)
+    wj = np.empty(8)
+    rows = np.empty(8, np.int64)
+    part = np.zeros((1, 1, 4))
+    for big_j in range(height):
         done = 0
         for big_i in range(width):
             k_lo, k_hi = inside[big_j, big_i, 0], inside[big_j, big_i, 1]
