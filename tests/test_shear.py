@@ -75,7 +75,10 @@ def test_exact_ends_match_naive_twin(method, filt, transfer, azimuth, elevation)
     assert np.abs(fast.rgba - lattice.rgba).max() > 1e-4  # the cut segments were counted
 
 
-@pytest.mark.parametrize("azimuth, elevation", [(100, -35), (200, 40), (30, 20)])
+@pytest.mark.parametrize("azimuth, elevation", [
+    (100, -35),
+    # Two more views in make test-all only (CI's five minutes).
+    pytest.param(200, 40, marks=pytest.mark.slow), pytest.param(30, 20, marks=pytest.mark.slow)])
 def test_exact_ends_bring_the_shear_methods_closer_to_the_exact_image(azimuth, elevation):
     """On Marschner-Lobb at 17^3 (live at every face), 24^2, one sample per voxel: the rmse
     against the exact image of the trilinear field. Measured: shear3 1.2e-2 to 1.4e-2 with
