@@ -230,6 +230,21 @@ def _over_lit(value, fraction, gx, gy, gz, tstart, tinv, alpha_tab, emit_tab, li
     buf[y, x, 3] += remaining * alpha
 
 
+@jit(inline="always")
+def _ray_sample(src, grads, lighting, y, x, lo, hi, position, fkind, fp0, fp1, fp2, radius,
+                ntaps, w):
+    """Pass 3's line of pixel ``(x, y)`` (data on ``lo .. hi``) resampled at ``position``, and
+    with ``lighting`` the gradient's components too: ``(value, gx, gy, gz)``."""
+    first = _line_taps(fkind, fp0, fp1, fp2, radius, ntaps, position, borrowed(w))
+    value = _taps_sum(src, y, x, lo, hi, first, ntaps, w)
+    gx = gy = gz = 0.0
+    if lighting:
+        gx = _taps_sum(grads[0], y, x, lo, hi, first, ntaps, w)
+        gy = _taps_sum(grads[1], y, x, lo, hi, first, ntaps, w)
+        gz = _taps_sum(grads[2], y, x, lo, hi, first, ntaps, w)
+    return value, gx, gy, gz
+
+
 @parallel_jit
 def resample_composite(src, c0, c1, c2, offset, line_lo, line_hi, fkind, fp0, fp1, fp2, radius,
                        ntaps, n_z, inverse, shift, limits, tstart, tinv, alpha_tab, color_tab,
@@ -313,15 +328,10 @@ def resample_composite(src, c0, c1, c2, offset, line_lo, line_hi, fkind, fp0, fp
                     continue
                 value = gx = gy = gz = 0.0
                 if q_first[x] <= z <= q_last[x]:
-                    lo = max(0, line_lo[y, x])
-                    hi = min(n - 1, line_hi[y, x])
-                    first = _line_taps(fkind, fp0, fp1, fp2, radius, ntaps,
-                                       (z - (offset + c1 * x + c2 * y)) / c0, borrowed(w))
-                    value = _taps_sum(src, y, x, lo, hi, first, ntaps, w)
-                    if lighting:
-                        gx = _taps_sum(grads[0], y, x, lo, hi, first, ntaps, w)
-                        gy = _taps_sum(grads[1], y, x, lo, hi, first, ntaps, w)
-                        gz = _taps_sum(grads[2], y, x, lo, hi, first, ntaps, w)
+                    value, gx, gy, gz = _ray_sample(
+                        src, grads, lighting, y, x, max(0, line_lo[y, x]),
+                        min(n - 1, line_hi[y, x]), (z - (offset + c1 * x + c2 * y)) / c0,
+                        fkind, fp0, fp1, fp2, radius, ntaps, w)
                     taken += 1
                 done += 1
                 if lighting:
@@ -346,13 +356,9 @@ def resample_composite(src, c0, c1, c2, offset, line_lo, line_hi, fkind, fp0, fp
                 position = (0.5 * (a + b) - base) / c0
                 value = gx = gy = gz = 0.0
                 if lo <= hi and lo - radius <= position <= hi + radius:
-                    first = _line_taps(fkind, fp0, fp1, fp2, radius, ntaps, position,
-                                       borrowed(w))
-                    value = _taps_sum(src, y, x, lo, hi, first, ntaps, w)
-                    if lighting:
-                        gx = _taps_sum(grads[0], y, x, lo, hi, first, ntaps, w)
-                        gy = _taps_sum(grads[1], y, x, lo, hi, first, ntaps, w)
-                        gz = _taps_sum(grads[2], y, x, lo, hi, first, ntaps, w)
+                    value, gx, gy, gz = _ray_sample(src, grads, lighting, y, x, lo, hi,
+                                                    position, fkind, fp0, fp1, fp2, radius,
+                                                    ntaps, w)
                     taken += 1
                 done += 1
                 part[0, 0, 0] = part[0, 0, 1] = part[0, 0, 2] = part[0, 0, 3] = 0.0
