@@ -22,7 +22,7 @@ from vrlib import validate
 from vrlib._kernels import projection as _kernel
 from vrlib.image import Image, RenderStats
 from vrlib.prefilter import Tally, prepared
-from vrlib.raycast import operations_per_sample
+from vrlib.raycast import SEGMENT_ENDS, operations_per_sample
 
 __all__ = ["render_projection", "classify_projected", "BLENDS"]
 
@@ -65,7 +65,7 @@ def render_projection(volume, view, *, filt, transfer, step, blend, segment_ends
     >>> round(float(img.rgba[4, 4, 0]), 3), round(float(img.alpha[4, 4]), 3)  # near the peak
     (0.992, 1.0)
     """
-    exact = validate.choice("segment_ends", segment_ends, ("lattice", "exact")) == "exact"
+    exact = validate.choice("segment_ends", segment_ends, SEGMENT_ENDS) == "exact"
     start = time.perf_counter()
     tally = Tally()
     volume = prepared(volume, filt, tally)

@@ -36,13 +36,10 @@ from vrlib._kernels._jit import readonly
 from vrlib.gradients import kernel_lighting, no_gradients
 from vrlib.image import Image, RenderStats
 from vrlib.prefilter import Tally, filter_lines, prepared, prepared_gradients
+from vrlib.raycast import SEGMENT_ENDS
 from vrlib.value_bounds import reconstructed_range
 
-__all__ = ["render_shear3", "render_shear2", "ShearPlan", "plan_shear", "INTERMEDIATES",
-           "SEGMENT_ENDS"]
-
-#: How the shear methods count the segments that the volume's faces cut (``segment_ends``).
-SEGMENT_ENDS = ("lattice", "exact")
+__all__ = ["render_shear3", "render_shear2", "ShearPlan", "plan_shear", "INTERMEDIATES"]
 
 
 class ShearPlan:

@@ -32,20 +32,19 @@ from vrlib.gradients import kernel_lighting, no_gradients
 from vrlib.image import Image, RenderStats
 from vrlib.prefilter import Tally, prepared, prepared_gradients
 from vrlib.projection import classify_projected
+from vrlib.raycast import SEGMENT_ENDS
 from vrlib.skipping import transparent_runs
 from vrlib.value_bounds import lattice_sums, reconstructed_range
 from vrlib.view import principal_axis
 
 __all__ = ["render_shearwarp", "project_shearwarp", "transparent_bound", "intermediate_plane",
            "sample_planes", "ray_stretches", "whole_planes", "warp_homography", "warp",
-           "MAX_PLANES_PER_SLICE", "SEGMENT_ENDS"]
+           "MAX_PLANES_PER_SLICE"]
 
 #: Final-image rows per unit of the warp's parallel work.
 WARP_BAND = 16
 #: The most sample planes per slice spacing shear-warp takes (``planes_per_slice``).
 MAX_PLANES_PER_SLICE = 64
-#: How shear-warp counts the segments that the volume's side faces cut (``segment_ends``).
-SEGMENT_ENDS = ("lattice", "exact")
 
 
 def ray_stretches(ends, shape, slice_shape):
@@ -393,7 +392,7 @@ def render_shearwarp(volume, view, *, filt, transfer, step, early_termination,
                 directions[..., a] = rays(grid)[..., column] * h[a]
             directions /= np.linalg.norm(directions, axis=-1, keepdims=True)
     low, high = reconstructed_range(volume, filt)
-    tables = transfer.segment_table(length / planes if planes > 1 else length, low, high)
+    tables = transfer.segment_table(length / planes, low, high)
     bound = -math.inf
     if empty_space_skipping and lattice_sums(filt)[2] <= 1.0 + 1e-6:
         bound = transparent_bound(transfer, low, high, length, min_opacity)
