@@ -21,7 +21,13 @@ __all__ = [
     "correct_opacity",
     "SEGMENT_MODELS",
     "ORDERS",
+    "SEGMENT_ENDS",
 ]
+
+#: How the segments that the volume's faces cut are counted (``segment_ends``, every method
+#: that integrates along rays): ``"lattice"``, each sample standing for its whole segment, or
+#: ``"exact"``, only the part inside the volume.
+SEGMENT_ENDS = ("lattice", "exact")
 
 #: Segment opacity models accepted by :func:`segment_alpha`.
 SEGMENT_MODELS = ("exact", "linear", "table")

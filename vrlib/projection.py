@@ -20,9 +20,10 @@ import numpy as np
 
 from vrlib import validate
 from vrlib._kernels import projection as _kernel
+from vrlib.compositing import SEGMENT_ENDS
 from vrlib.image import Image, RenderStats
 from vrlib.prefilter import Tally, prepared
-from vrlib.raycast import SEGMENT_ENDS, operations_per_sample
+from vrlib.raycast import operations_per_sample
 
 __all__ = ["render_projection", "classify_projected", "BLENDS"]
 

@@ -26,6 +26,7 @@ from vrlib._kernels._jit import compiled_or_cached, readonly
 from vrlib._kernels.filters import MAX_TAPS, TENT
 from vrlib._scheduling import on_threads
 from vrlib.adaptive import step_multipliers
+from vrlib.compositing import SEGMENT_ENDS
 from vrlib.image import Image, RenderStats
 from vrlib.prefilter import Tally, prepared
 from vrlib.skipping import BLOCK, footprint_mask, footprint_ready, skip_grid, visible_box
@@ -117,8 +118,6 @@ def operations_per_sample(filt, *, shading=False):
     return ops
 
 
-#: How the segments that the volume's faces cut are counted (``segment_ends``).
-SEGMENT_ENDS = ("lattice", "exact")
 #: How a segment is classified (``classification``).
 CLASSIFICATIONS = ("point", "preintegrated")
 

@@ -33,10 +33,10 @@ import numpy as np
 from vrlib import validate
 from vrlib._kernels import shear as _kernel
 from vrlib._kernels._jit import readonly
+from vrlib.compositing import SEGMENT_ENDS
 from vrlib.gradients import kernel_lighting, no_gradients
 from vrlib.image import Image, RenderStats
 from vrlib.prefilter import Tally, filter_lines, prepared, prepared_gradients
-from vrlib.raycast import SEGMENT_ENDS
 from vrlib.value_bounds import reconstructed_range
 
 __all__ = ["render_shear3", "render_shear2", "ShearPlan", "plan_shear", "INTERMEDIATES"]

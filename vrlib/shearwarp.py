@@ -28,11 +28,11 @@ from vrlib._kernels import shear as _kernel
 from vrlib._kernels._jit import readonly
 from vrlib._kernels.shear import SLAB_EDGE
 from vrlib._scheduling import on_threads, thread_number
+from vrlib.compositing import SEGMENT_ENDS
 from vrlib.gradients import kernel_lighting, no_gradients
 from vrlib.image import Image, RenderStats
 from vrlib.prefilter import Tally, prepared, prepared_gradients
 from vrlib.projection import classify_projected
-from vrlib.raycast import SEGMENT_ENDS
 from vrlib.skipping import transparent_runs
 from vrlib.value_bounds import lattice_sums, reconstructed_range
 from vrlib.view import principal_axis
